@@ -1,0 +1,109 @@
+"""The paper's pipelines with the paper's numbers as defaults."""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from sklearn.pipeline import Pipeline
+
+from skgesture._descriptor import PoseDescriptor
+from skgesture._multiscale import MultiScaleClassifier
+from skgesture._segmenter import ActivitySegmenter
+from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
+
+__all__ = ["make_method_a", "make_method_b", "make_method_c"]
+
+# METHOD_SPEC §6.3
+WEIGHTS_B = (0.4895, 0.4576, 0.0529)
+THRESHOLD_SHORT_B = 0.6014
+THRESHOLD_LONG_B = 0.6033
+
+_DOC_COMMON = """
+    Parameters
+    ----------
+    joints : {"paper11", "full20"} or DescriptorJoints, default="paper11"
+        Joint set of the :class:`PoseDescriptor`.
+    segment : bool, default=True
+        Put an :class:`ActivitySegmenter` in front of the classifier. Without
+        it every sequence is one period (pre-cut clips).
+    memory : None, str or joblib.Memory, default=None
+        Cache of the trained networks (see :class:`ActivitySegmenter`), so
+        decision parameters can be searched without retraining.
+    random_state : int, RandomState instance or None, default=None
+        Seeds every network.
+    verbose : int, default=0
+        Verbosity of the networks.
+"""
+
+
+def _multiscale_pipeline(steps, classifier_kwargs, *, joints, segment, memory,
+                         random_state, verbose):
+    stages = [("descriptor", PoseDescriptor(joints=joints))]
+    if segment:
+        stages.append(
+            ("segmenter", ActivitySegmenter(memory=memory, random_state=random_state,
+                                            verbose=verbose))
+        )
+    stages += [
+        ("windows", DynamicPoseWindow(steps=steps)),
+        ("classifier", MultiScaleClassifier(steps=steps, memory=memory,
+                                            random_state=random_state, verbose=verbose,
+                                            **classifier_kwargs)),
+    ]
+    return Pipeline(stages)
+
+
+def make_method_a(*, joints="paper11", segment=True, memory=None, random_state=None,
+                  verbose=0):
+    """Method A: descriptor, segmenter, single-scale dynamic-pose classifier.
+
+    PoseDescriptor -> ActivitySegmenter -> DynamicPoseWindow(steps=(4,)) ->
+    MultiScaleClassifier with thresholds 0.8717 (short periods) and 0.6255
+    (long periods), METHOD_SPEC §5.
+    {common}
+    Returns
+    -------
+    sklearn.pipeline.Pipeline
+        The unfitted pipeline; ``predict`` gives per-frame labels.
+
+    Examples
+    --------
+    >>> from skgesture import make_method_a
+    >>> [name for name, _ in make_method_a().steps]
+    ['descriptor', 'segmenter', 'windows', 'classifier']
+    """
+    return _multiscale_pipeline(
+        STEPS_A, {}, joints=joints, segment=segment, memory=memory,
+        random_state=random_state, verbose=verbose,
+    )
+
+
+def make_method_b(*, joints="paper11", segment=True, memory=None, random_state=None,
+                  verbose=0):
+    """Method B: three time scales (steps 4, 3, 2) with fused scores.
+
+    As :func:`make_method_a` with ``steps=(4, 3, 2)``, fusion weights
+    (0.4895, 0.4576, 0.0529) and thresholds 0.6014 / 0.6033, METHOD_SPEC §6.
+    {common}
+    Returns
+    -------
+    sklearn.pipeline.Pipeline
+        The unfitted pipeline.
+
+    Examples
+    --------
+    >>> from skgesture import make_method_b
+    >>> make_method_b().named_steps["classifier"].weights
+    (0.4895, 0.4576, 0.0529)
+    """
+    kwargs = {
+        "weights": WEIGHTS_B,
+        "threshold_short": THRESHOLD_SHORT_B,
+        "threshold_long": THRESHOLD_LONG_B,
+    }
+    return _multiscale_pipeline(
+        STEPS_B, kwargs, joints=joints, segment=segment, memory=memory,
+        random_state=random_state, verbose=verbose,
+    )
+
+
+make_method_a.__doc__ = make_method_a.__doc__.format(common=_DOC_COMMON)
+make_method_b.__doc__ = make_method_b.__doc__.format(common=_DOC_COMMON)

@@ -1,0 +1,313 @@
+"""ActivitySegmenter: framewise gesture-vs-rest network, smoothing and periods."""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, _fit_context
+from sklearn.utils import check_random_state
+from sklearn.utils._param_validation import HasMethods, Interval
+from sklearn.utils.validation import check_is_fitted
+
+from skgesture._mlp import TorchMLPClassifier
+from skgesture._networks import fit_inner_estimator
+from skgesture.utils._segments import remove_short_runs, runs
+from skgesture.utils._smoothing import loess_smooth
+from skgesture.utils._validation import check_sequence_labels, check_sequences
+
+__all__ = ["ActivitySegmenter"]
+
+# METHOD_SPEC §4
+SEGMENTER_HIDDEN = (100, 100)
+SEGMENTER_ACTIVATIONS = ("relu", "tanh")
+N_CONTEXT = 10  # rest frames before and after each gesture (decision D13)
+THRESHOLD = 0.4
+MIN_LENGTH = 12
+SMOOTH_SPAN = 15  # decision D12
+
+
+def context_mask(y, n_context):
+    """Training frames of the segmenter in one sequence (METHOD_SPEC §4.1).
+
+    Every gesture frame, plus up to ``n_context`` rest frames right before and
+    right after each gesture (all rest frames when ``n_context`` is None).
+
+    Parameters
+    ----------
+    y : ndarray of shape (n_frames,)
+        Per-frame labels, 0 = rest.
+    n_context : int or None
+        Rest frames taken on each side of a gesture.
+
+    Returns
+    -------
+    ndarray of bool of shape (n_frames,)
+        Frames to train on.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._segmenter import context_mask
+    >>> context_mask(np.array([0, 0, 0, 5, 5, 0, 0, 0]), 2).astype(int).tolist()
+    [0, 1, 1, 1, 1, 1, 1, 0]
+    """
+    gesture = y > 0
+    if n_context is None:
+        return np.ones_like(gesture)
+    keep = gesture.copy()
+    starts, ends, vals = runs(gesture)
+    T = len(y)
+    for s, e in zip(starts[vals], ends[vals]):
+        keep[max(0, s - n_context) : s] = True
+        keep[e : min(T, e + n_context)] = True
+    return keep
+
+
+class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
+    """Framewise gesture-vs-rest detector giving the periods of activity.
+
+    A network scores every frame's descriptor; the score track is smoothed with
+    MATLAB-style loess, thresholded, and runs of active frames shorter than
+    ``min_length`` are dropped (METHOD_SPEC §4). ``predict`` gives per-frame 0/1;
+    ``transform`` hands the features on as masked arrays whose masked rows are
+    rest, which is how :class:`DynamicPoseWindow` and
+    :class:`MultiScaleClassifier` learn where the periods are.
+
+    Parameters
+    ----------
+    estimator : classifier or None, default=None
+        A 2-D classifier with ``predict_proba`` trained on single frames. ``None``
+        uses the paper's network: :class:`TorchMLPClassifier` 100 (ReLU) - 100
+        (tanh) - 1 (sigmoid), trained with scaled conjugate gradient.
+    n_context : int or None, default=10
+        Rest frames taken as negatives before and after each gesture; ``None``
+        takes every rest frame (decision D13).
+    threshold : float, default=0.4
+        A frame is active when its smoothed score exceeds this.
+    min_length : int, default=12
+        Shortest period of activity kept, in frames.
+    smooth_span : int or float, default=15
+        Loess span in frames (a float below 1 is a fraction of the sequence);
+        5 leaves interior frames unchanged (decision D12).
+    memory : None, str or joblib.Memory, default=None
+        Caches the trained network keyed on the training frames and the
+        network's parameters only, so a search over ``threshold``,
+        ``min_length`` or ``smooth_span`` trains once per fold.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the network (overrides the estimator's own ``random_state``).
+    verbose : int, default=0
+        Verbosity.
+
+    Attributes
+    ----------
+    estimator_ : classifier
+        The fitted frame classifier.
+    classes_ : ndarray of shape (2,)
+        ``[0, 1]``: rest and gesture.
+    n_features_in_ : int
+        Descriptor width.
+    frame_shape_in_ : tuple of int
+        Shape of one input frame.
+
+    See Also
+    --------
+    PoseDescriptor : Gives the per-frame features.
+    DynamicPoseWindow : Builds the windows classified inside each period.
+
+    Notes
+    -----
+    ``predict_proba`` is the network's raw per-frame output; ``decision_function``
+    is the smoothed score that ``threshold`` applies to.
+
+    Examples
+    --------
+    >>> from skgesture import ActivitySegmenter, PoseDescriptor, TorchMLPClassifier
+    >>> from skgesture.utils._testing import make_skeleton_stream
+    >>> X, y = make_skeleton_stream(random_state=0)
+    >>> D = PoseDescriptor().fit_transform([X])
+    >>> net = TorchMLPClassifier(hidden_layer_sizes=(16,), activations=("tanh",),
+    ...                          max_epochs=40)
+    >>> seg = ActivitySegmenter(estimator=net, random_state=0).fit(D, [y])
+    >>> seg.predict(D)[0].shape == y.shape
+    True
+    """
+
+    _parameter_constraints: dict = {
+        "estimator": [HasMethods(["fit", "predict_proba"]), None],
+        "n_context": [Interval(Integral, 0, None, closed="left"), None],
+        "threshold": [Interval(Real, 0, 1, closed="both")],
+        "min_length": [Interval(Integral, 1, None, closed="left")],
+        "smooth_span": [Interval(Real, 0, None, closed="neither")],
+        "memory": [None, str, HasMethods(["cache"])],
+        "random_state": ["random_state"],
+        "verbose": ["verbose"],
+    }
+
+    def __init__(
+        self,
+        estimator=None,
+        *,
+        n_context=N_CONTEXT,
+        threshold=THRESHOLD,
+        min_length=MIN_LENGTH,
+        smooth_span=SMOOTH_SPAN,
+        memory=None,
+        random_state=None,
+        verbose=0,
+    ):
+        self.estimator = estimator
+        self.n_context = n_context
+        self.threshold = threshold
+        self.min_length = min_length
+        self.smooth_span = smooth_span
+        self.memory = memory
+        self.random_state = random_state
+        self.verbose = verbose
+
+    @_fit_context(prefer_skip_nested_validation=False)
+    def fit(self, X, y):
+        """Train the frame network on gesture frames and the rest around them.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features (e.g. from :class:`PoseDescriptor`).
+        y : list of ndarray of shape (n_frames_i,)
+            Per-frame labels; every label > 0 counts as gesture.
+
+        Returns
+        -------
+        self : ActivitySegmenter
+            The fitted segmenter.
+        """
+        X = check_sequences(X, ndim=2, estimator=self, reset=True)
+        y = check_sequence_labels(y, X)
+        keep = [context_mask(lab, self.n_context) for lab in y]
+        Xf = np.concatenate([x[k] for x, k in zip(X, keep)])
+        yf = np.concatenate([(lab[k] > 0).astype(np.int64) for lab, k in zip(y, keep)])
+        n_pos = int(yf.sum())
+        if n_pos == 0:
+            raise ValueError(
+                "y has no gesture frame (every label is 0): the segmenter needs "
+                "gesture and rest frames"
+            )
+        if n_pos == len(yf):
+            raise ValueError(
+                "y has no rest frame near any gesture (label 0): the segmenter "
+                "needs gesture and rest frames"
+            )
+        rng = check_random_state(self.random_state) if self.random_state is not None else None
+        default = TorchMLPClassifier(
+            hidden_layer_sizes=SEGMENTER_HIDDEN, activations=SEGMENTER_ACTIVATIONS
+        )
+        self.estimator_ = fit_inner_estimator(
+            self.estimator, default, Xf, yf, rng=rng, memory=self.memory
+        )
+        self.classes_ = np.array([0, 1])
+        return self
+
+    def predict_proba(self, X):
+        """Raw per-frame probabilities of rest and gesture (before smoothing).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i, 2)
+            Columns: rest, gesture.
+        """
+        check_is_fitted(self)
+        X = check_sequences(X, ndim=2, estimator=self, reset=False)
+        lengths = [len(x) for x in X]
+        proba = self.estimator_.predict_proba(np.concatenate(X))
+        pos = proba[:, list(self.estimator_.classes_).index(1)]
+        pos = np.split(pos, np.cumsum(lengths)[:-1])
+        return [np.column_stack([1.0 - p, p]) for p in pos]
+
+    def decision_function(self, X):
+        """Smoothed gesture score of every frame.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i,)
+            Loess-smoothed gesture probability.
+        """
+        return [self._smooth(p[:, 1]) for p in self.predict_proba(X)]
+
+    def predict(self, X):
+        """Per-frame activity: 1 inside a period of activity, else 0.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i,)
+            0/1 labels.
+        """
+        return [self._periods(s) for s in self.decision_function(X)]
+
+    def transform(self, X):
+        """The features with rest frames masked.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of numpy.ma.MaskedArray of shape (n_frames_i, n_features)
+            Same values; rows outside every period of activity are masked.
+        """
+        active = self.predict(X)
+        X = check_sequences(X, ndim=2, estimator=self, reset=False)
+        return [
+            np.ma.MaskedArray(x, mask=np.broadcast_to(~a.astype(bool)[:, None], x.shape))
+            for x, a in zip(X, active)
+        ]
+
+    def score(self, X, y, sample_weight=None):
+        """Frame accuracy of the gesture-vs-rest decision.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+        y : list of ndarray of shape (n_frames_i,)
+            Per-frame labels; every label > 0 counts as gesture.
+        sample_weight : None
+            Not supported.
+
+        Returns
+        -------
+        float
+            Share of frames whose activity is predicted correctly.
+        """
+        y = check_sequence_labels(y, X)
+        pred = np.concatenate(self.predict(X))
+        return float(np.mean(pred == (np.concatenate(y) > 0)))
+
+    def _smooth(self, score):
+        return np.asarray(loess_smooth(score, self.smooth_span))
+
+    def _periods(self, smoothed):
+        active = (smoothed > self.threshold).astype(np.int64)
+        return remove_short_runs(active, self.min_length)
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        return tags

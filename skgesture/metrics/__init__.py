@@ -1,0 +1,41 @@
+"""Evaluation of per-frame gesture labellings.
+
+The ChaLearn LAP 2014 Jaccard index exactly as the official script computes it
+(with the penalised and inclusive variants of METHOD_SPEC §2.3), frame accuracy,
+the frame confusion matrix, the segmental F1@k and edit scores of temporal action
+segmentation, and scorers for ``GridSearchCV``.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from skgesture.metrics._jaccard import jaccard_index, jaccard_index_segments
+from skgesture.metrics._scorers import (
+    SCORERS,
+    get_scorer,
+    jaccard_scorer,
+    make_jaccard_scorer,
+    make_sequence_scorer,
+)
+from skgesture.metrics._segmental import (
+    edit_score,
+    frame_accuracy,
+    frame_confusion_matrix,
+    segmental_f1,
+)
+from skgesture.utils._segments import labels_to_segments, segments_to_labels
+
+__all__ = [
+    "jaccard_index",
+    "jaccard_index_segments",
+    "frame_accuracy",
+    "frame_confusion_matrix",
+    "segmental_f1",
+    "edit_score",
+    "jaccard_scorer",
+    "make_jaccard_scorer",
+    "make_sequence_scorer",
+    "get_scorer",
+    "SCORERS",
+    "labels_to_segments",
+    "segments_to_labels",
+]

@@ -1,0 +1,25 @@
+"""Shared helpers: sequence validation, segments, smoothing, resizing, SCG."""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from skgesture.utils._segments import (
+    labels_to_segments,
+    remove_short_runs,
+    runs,
+    segments_to_labels,
+)
+from skgesture.utils._validation import (
+    check_sequence_labels,
+    check_sequences,
+    missing_frames,
+)
+
+__all__ = [
+    "check_sequences",
+    "check_sequence_labels",
+    "missing_frames",
+    "labels_to_segments",
+    "segments_to_labels",
+    "runs",
+    "remove_short_runs",
+]

@@ -1,0 +1,155 @@
+"""Conversions between per-frame labels and gesture instances (segments).
+
+A segment is one row ``(class, start, end)`` of an integer array of shape
+``(n_segments, 3)``: 0-based ``start``, **exclusive** ``end`` (a Python slice),
+``class >= 1``. The ChaLearn files use 1-based inclusive frames; the loaders and
+the writer convert (``start + 1``, ``end``).
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import warnings
+
+import numpy as np
+
+__all__ = ["labels_to_segments", "segments_to_labels", "runs", "remove_short_runs"]
+
+
+def runs(values):
+    """Maximal runs of equal values in a 1-D array.
+
+    Parameters
+    ----------
+    values : array-like of shape (n,)
+        The values.
+
+    Returns
+    -------
+    starts, ends, vals : ndarray
+        Run starts (inclusive), ends (exclusive) and their values.
+
+    Examples
+    --------
+    >>> from skgesture.utils import runs
+    >>> [a.tolist() for a in runs([0, 0, 2, 2, 2, 0])]
+    [[0, 2, 5], [2, 5, 6], [0, 2, 0]]
+    """
+    v = np.asarray(values)
+    if v.size == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, v[:0]
+    change = np.flatnonzero(v[1:] != v[:-1]) + 1
+    starts = np.concatenate(([0], change))
+    ends = np.concatenate((change, [v.size]))
+    return starts, ends, v[starts]
+
+
+def labels_to_segments(y, *, rest=0):
+    """Turn per-frame labels into gesture instances.
+
+    Each maximal run of one non-rest label becomes one segment.
+
+    Parameters
+    ----------
+    y : array-like of shape (n_frames,)
+        Per-frame labels.
+    rest : int, default=0
+        The rest label.
+
+    Returns
+    -------
+    ndarray of shape (n_segments, 3)
+        Rows ``(class, start, end)``, 0-based, ``end`` exclusive, sorted by start.
+
+    Examples
+    --------
+    >>> from skgesture.metrics import labels_to_segments
+    >>> labels_to_segments([0, 3, 3, 0, 5, 5, 5]).tolist()
+    [[3, 1, 3], [5, 4, 7]]
+    """
+    starts, ends, vals = runs(np.asarray(y).astype(np.int64))
+    keep = vals != rest
+    return np.stack([vals[keep], starts[keep], ends[keep]], axis=1).reshape(-1, 3)
+
+
+def segments_to_labels(segments, n_frames, *, on_overlap="raise"):
+    """Turn gesture instances into per-frame labels.
+
+    Parameters
+    ----------
+    segments : array-like of shape (n_segments, 3)
+        Rows ``(class, start, end)``, 0-based, ``end`` exclusive.
+    n_frames : int
+        Length of the sequence.
+    on_overlap : {"raise", "warn", "later"}, default="raise"
+        What to do with frames claimed by two segments: raise a ``ValueError``,
+        warn and let the later segment win, or let it win silently.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        Per-frame labels, 0 outside every segment.
+
+    Examples
+    --------
+    >>> from skgesture.metrics import segments_to_labels
+    >>> segments_to_labels([[3, 1, 3], [5, 4, 7]], 8).tolist()
+    [0, 3, 3, 0, 5, 5, 5, 0]
+    """
+    if on_overlap not in ("raise", "warn", "later"):
+        raise ValueError(f"on_overlap must be 'raise', 'warn' or 'later', got {on_overlap!r}")
+    seg = np.asarray(segments, dtype=np.int64).reshape(-1, 3)
+    y = np.zeros(int(n_frames), dtype=np.int64)
+    claimed = np.zeros(int(n_frames), dtype=bool)
+    for row, (c, s, e) in enumerate(seg):
+        if c < 1:
+            raise ValueError(f"segment {row} has class {c}; gesture classes are >= 1")
+        if s < 0 or e > n_frames or s >= e:
+            raise ValueError(
+                f"segment {row} = ({c}, {s}, {e}) is outside 0 <= start < end <= "
+                f"{n_frames}"
+            )
+        if claimed[s:e].any():
+            frame = s + int(np.argmax(claimed[s:e]))
+            msg = (
+                f"segment {row} = ({c}, {s}, {e}) overlaps an earlier segment at "
+                f"frame {frame}"
+            )
+            if on_overlap == "raise":
+                raise ValueError(msg)
+            if on_overlap == "warn":
+                warnings.warn(msg + "; the later segment wins", stacklevel=2)
+        y[s:e] = c
+        claimed[s:e] = True
+    return y
+
+
+def remove_short_runs(labels, min_length, *, rest=0):
+    """Set every run of one non-rest label shorter than ``min_length`` to ``rest``.
+
+    Parameters
+    ----------
+    labels : array-like of shape (n_frames,)
+        Per-frame labels.
+    min_length : int
+        Shortest run kept.
+    rest : int, default=0
+        The rest label.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        A filtered copy.
+
+    Examples
+    --------
+    >>> from skgesture.utils import remove_short_runs
+    >>> remove_short_runs([0, 2, 2, 0, 3, 3, 3, 3], 3).tolist()
+    [0, 0, 0, 0, 3, 3, 3, 3]
+    """
+    out = np.array(labels, copy=True)
+    starts, ends, vals = runs(out)
+    for s, e, v in zip(starts, ends, vals):
+        if v != rest and e - s < min_length:
+            out[s:e] = rest
+    return out
