@@ -4,6 +4,7 @@
 
 from sklearn.pipeline import Pipeline
 
+from skgesture._bilstm import BiLSTMTagger
 from skgesture._descriptor import PoseDescriptor
 from skgesture._multiscale import MultiScaleClassifier
 from skgesture._segmenter import ActivitySegmenter
@@ -107,3 +108,47 @@ def make_method_b(*, joints="paper11", segment=True, memory=None, random_state=N
 
 make_method_a.__doc__ = make_method_a.__doc__.format(common=_DOC_COMMON)
 make_method_b.__doc__ = make_method_b.__doc__.format(common=_DOC_COMMON)
+
+
+def make_method_c(*, joints="paper11", memory=None, random_state=None, verbose=0,
+                  paper=False, device="cpu"):
+    """Method C: descriptor and bidirectional LSTM tagger, no segmentation stage.
+
+    PoseDescriptor -> BiLSTMTagger: every frame gets one of K + 1 classes,
+    probabilities are loess-smoothed and gesture runs shorter than 15 frames
+    become rest (METHOD_SPEC §7).
+
+    Parameters
+    ----------
+    joints : {"paper11", "full20"} or DescriptorJoints, default="paper11"
+        Joint set of the :class:`PoseDescriptor`.
+    memory : None, str or joblib.Memory, default=None
+        Cache of the trained network, so ``tagger__smooth_span``,
+        ``tagger__min_run`` and ``tagger__overlap`` can be searched without
+        retraining.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the network.
+    verbose : int, default=0
+        Verbosity of the training (1: one line per epoch).
+    paper : bool, default=False
+        Use the paper's network (:meth:`BiLSTMTagger.paper`: 1024-1024-512
+        units, dropout 0.6, 150 epochs) instead of the CPU-sized default.
+    device : str, default="cpu"
+        Torch device of the training; ``"cuda"`` is advised with ``paper=True``.
+
+    Returns
+    -------
+    sklearn.pipeline.Pipeline
+        The unfitted pipeline; ``predict`` gives per-frame labels.
+
+    Examples
+    --------
+    >>> from skgesture import make_method_c
+    >>> pipe = make_method_c(paper=True, device="cuda")
+    >>> [name for name, _ in pipe.steps], pipe.named_steps["tagger"].hidden_sizes
+    (['descriptor', 'tagger'], (1024, 1024, 512))
+    """
+    params = {"memory": memory, "random_state": random_state, "verbose": verbose,
+              "device": device}
+    tagger = BiLSTMTagger.paper(**params) if paper else BiLSTMTagger(**params)
+    return Pipeline([("descriptor", PoseDescriptor(joints=joints)), ("tagger", tagger)])

@@ -42,7 +42,9 @@ def _scalar_imresize(col, m):
     out = []
     for i in range(1, m + 1):
         u = i / scale + 0.5 * (1 - 1 / scale)
-        js = range(math.floor(u - width / 2), math.floor(u - width / 2) + 7 + int(width))
+        js = range(
+            math.floor(u - width / 2), math.floor(u - width / 2) + 7 + int(width)
+        )
         ws = [scale * _keys(scale * (u - j)) if shrink else _keys(u - j) for j in js]
         total = sum(ws)
         out.append(sum(w * col[_mirror(j, n) - 1] for w, j in zip(ws, js)) / total)
@@ -53,8 +55,10 @@ def test_bicubic_matches_spec_test_vector():
     assert_allclose(resize_frames(COLUMN_GT, 9), RESIZED_9_GT, rtol=0, atol=ATOL_4DP)
 
 
-@pytest.mark.parametrize(("n_in", "n_out"), [(4, 9), (16, 17), (9, 17), (2, 17),
-                                             (3, 5), (8, 4), (17, 5), (10, 7)])  # fmt: skip
+@pytest.mark.parametrize(
+    ("n_in", "n_out"),
+    [(4, 9), (16, 17), (9, 17), (2, 17), (3, 5), (8, 4), (17, 5), (10, 7)],
+)
 def test_bicubic_matches_scalar_transcription(n_in, n_out):
     col = np.random.default_rng(n_in * 31 + n_out).standard_normal(n_in)
     assert_allclose(resize_frames(col, n_out), _scalar_imresize(col, n_out), atol=1e-12)
@@ -79,8 +83,8 @@ def test_same_length_is_identity(method):
 @pytest.mark.parametrize("method", ["bicubic", "pchip", "spline"])
 def test_single_frame_is_repeated(method):
     x = np.array([[1.0, -2.0, 3.0]])
-    assert_array_equal(resize_frames(x, N_MIN_FRAMES, method=method),
-                       np.repeat(x, N_MIN_FRAMES, axis=0))  # fmt: skip
+    out = resize_frames(x, N_MIN_FRAMES, method=method)
+    assert_array_equal(out, np.repeat(x, N_MIN_FRAMES, axis=0))
 
 
 @pytest.mark.parametrize("method", ["pchip", "spline"])
@@ -124,11 +128,13 @@ def test_columns_are_resized_independently(method):
     out = resize_frames(x, N_MIN_FRAMES, method=method)
     assert out.shape == (N_MIN_FRAMES, 183)
     for k in (0, 57, 182):
-        assert_allclose(out[:, k], resize_frames(x[:, k], N_MIN_FRAMES, method=method),
-                        atol=1e-12)  # fmt: skip
+        expected = resize_frames(x[:, k], N_MIN_FRAMES, method=method)
+        assert_allclose(out[:, k], expected, atol=1e-12)
 
 
-@pytest.mark.parametrize(("n_in", "n_out"), [(1, 5), (2, 17), (16, 17), (8, 4), (20, 3)])
+@pytest.mark.parametrize(
+    ("n_in", "n_out"), [(1, 5), (2, 17), (16, 17), (8, 4), (20, 3)]
+)
 def test_weight_rows_sum_to_one(n_in, n_out):
     w = imresize_weights(n_in, n_out)
     assert w.shape == (n_out, n_in)

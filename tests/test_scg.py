@@ -1,4 +1,4 @@
-"""Scaled Conjugate Gradient (METHOD_SPEC §8.6, §11 item 9) on problems with known answers."""
+"""SCG (METHOD_SPEC §8.6, §11 item 9) on problems with known answers."""
 
 import math
 
@@ -136,6 +136,7 @@ def test_quadratic_is_solved_in_about_n_steps(n):
         assert opt.info["lambd"] >= 0
     assert_allclose(w.detach().numpy(), sol, rtol=0, atol=1e-8)
     assert opt.info["grad_norm"] < 1e-7
+    assert opt.grad_norm == opt.info["grad_norm"]
 
 
 def test_rosenbrock_converges_to_the_minimum():
@@ -199,7 +200,9 @@ def test_rejected_steps_leave_weights_unchanged():
             assert opt.info["comparison"] < 0
             assert opt.info["loss"] == loss_before
             # the gradient left in .grad belongs to the restored weights
-            assert_allclose(w.grad.numpy(), (before / torch.sqrt(1 + before**2)).numpy())
+            assert_allclose(
+                w.grad.numpy(), (before / torch.sqrt(1 + before**2)).numpy()
+            )
         else:
             assert _soft_abs(w.detach()).item() <= loss_before
     assert n_rejected >= 2  # observed: the first two steps overshoot
@@ -209,8 +212,9 @@ def test_rejected_steps_leave_weights_unchanged():
 def test_float32_parameters_keep_their_dtype_and_converge():
     a, b, sol = _quadratic(6, seed=0)
     at, bt = torch.tensor(a, dtype=torch.float32), torch.tensor(b, dtype=torch.float32)
-    w, opt, closure = _make(lambda w: 0.5 * w @ at @ w - bt @ w, np.zeros(6),
-                            dtype=torch.float32)  # fmt: skip
+    w, opt, closure = _make(
+        lambda w: 0.5 * w @ at @ w - bt @ w, np.zeros(6), dtype=torch.float32
+    )
     storage = w.data_ptr()
     for _ in range(30):
         opt.step(closure)
@@ -249,7 +253,8 @@ def test_step_returns_the_loss_before_the_step():
     w, opt, closure = _make(_rosenbrock, ROSENBROCK_START)
     first = opt.step(closure)
     assert_allclose(first.item(), _rosenbrock(np.array(ROSENBROCK_START)))
-    assert opt.info["loss"] < float(first)
+    assert opt.info["loss"] < first.item()
+    assert not first.requires_grad
 
 
 def test_state_dict_round_trip_continues_identically():
@@ -274,8 +279,8 @@ def test_external_weight_change_restarts_the_direction():
     n_evals = opt.info["n_evals"]
     opt.step(closure)
     # As a fresh start from (0.5, 0.5) with the current λ: p = -g, new curvature.
-    (w_ref, lam_ref, accepted), = _reference_scg(*_autograd(_rosenbrock), [0.5, 0.5],
-                                                 1, lambd=lam)  # fmt: skip
+    trajectory, _ = _reference_scg(*_autograd(_rosenbrock), [0.5, 0.5], 1, lambd=lam)
+    w_ref, _, accepted = trajectory[0]
     assert accepted and opt.info["success"]
     assert_allclose(w.detach().numpy(), w_ref, rtol=1e-12)
     assert opt.info["n_evals"] == n_evals + 3  # re-evaluated at the moved weights
@@ -304,16 +309,19 @@ def test_closure_returning_none_raises_and_restores_weights():
     assert torch.equal(w.detach(), before)
 
 
-@pytest.mark.parametrize(("kwargs", "match"), [({"sigma": 0.0}, "sigma"),
-                                               ({"lambd": -1.0}, "lambd")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("kwargs", "match"), [({"sigma": 0.0}, "sigma"), ({"lambd": -1.0}, "lambd")]
+)
 def test_invalid_hyperparameters_raise(kwargs, match):
     with pytest.raises(ValueError, match=match):
         SCG([torch.zeros(2, requires_grad=True)], **kwargs)
 
 
 def test_groups_with_different_settings_raise():
-    groups = [{"params": [torch.zeros(1, requires_grad=True)]},
-              {"params": [torch.zeros(1, requires_grad=True)], "sigma": 1e-3}]  # fmt: skip
+    groups = [
+        {"params": [torch.zeros(1, requires_grad=True)]},
+        {"params": [torch.zeros(1, requires_grad=True)], "sigma": 1e-3},
+    ]
     with pytest.raises(ValueError, match="same in every group"):
         SCG(groups)
 
@@ -321,6 +329,7 @@ def test_groups_with_different_settings_raise():
 def test_defaults_are_matlab_trainscg():
     opt = SCG([torch.zeros(1, requires_grad=True)])
     assert opt.defaults["sigma"] == SIGMA_GT and opt.defaults["lambd"] == LAMBDA_GT
+    assert opt.grad_norm is None  # no step taken yet
 
 
 def test_skorch_binary_classifier_trains_with_scg():

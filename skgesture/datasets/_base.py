@@ -36,6 +36,10 @@ class DataFileWarning(UserWarning):
     Raised for padded or truncated skeletons, overlapping labels, all-zero
     skeleton files and similar facts a user should know about.
 
+    See Also
+    --------
+    skgesture.datasets.load_chalearn : A loader that emits it.
+
     Examples
     --------
     >>> import warnings

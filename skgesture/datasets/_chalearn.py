@@ -244,6 +244,9 @@ def _parse_labels(lines, name, n_frames=None):
 def read_chalearn_labels(file, *, n_frames=None):
     """Read a ChaLearn labels or prediction file into segments.
 
+    The 1-based inclusive ``class,start,end`` lines become rows of the package's
+    segment convention (0-based start, exclusive end).
+
     Parameters
     ----------
     file : str or path-like
@@ -263,6 +266,11 @@ def read_chalearn_labels(file, *, n_frames=None):
     ValueError
         Naming the file and line of a malformed line, a class outside 1..20 or a
         start after the end.
+
+    See Also
+    --------
+    write_chalearn_predictions : Write such files.
+    load_chalearn : Read whole samples.
 
     Examples
     --------
@@ -393,8 +401,8 @@ def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=N
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
-        With keys
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys
 
         X : list of ndarray of shape (n_frames_i, 20, 3) or None
             World joint positions in metres, Kinect v1 NUI joint order (float64).
@@ -622,9 +630,9 @@ def write_chalearn_predictions(predictions, sample_ids, folder, *, n_frames=None
     folder : str or path-like
         Output folder, created if needed.
     n_frames : int, list of int or None, default=None
-        numFrames of each sequence (e.g. ``data.n_frames``). Frames are clamped
-        to ``1 <= start <= end <= numFrames`` (METHOD_SPEC §2.2); without it only
-        ``start >= 1`` is enforced (and labels past it are dropped).
+        Number of frames (numFrames) of each sequence (e.g. ``data.n_frames``). Frames
+        are clamped to ``1 <= start <= end <= numFrames`` (METHOD_SPEC §2.2); without it
+        only ``start >= 1`` is enforced (and labels past it are dropped).
 
     Returns
     -------

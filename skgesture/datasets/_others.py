@@ -107,6 +107,9 @@ def _action_point_frames(ticks, timestamps):
 def load_msrc12(path):
     """Load (a subset of) the MSRC-12 Kinect gesture dataset.
 
+    Continuous 30 Hz streams, each with about 10 repetitions of one of 12
+    gestures, annotated with action points (not intervals).
+
     Parameters
     ----------
     path : str or path-like
@@ -115,16 +118,16 @@ def load_msrc12(path):
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
-        With keys ``X`` (list of (n_frames_i, 20, 3) float64 arrays, metres,
-        Kinect v1 NUI order; the ``w`` column is dropped), ``y`` (all zeros: no
-        intervals are annotated), ``segments`` (empty (0, 3) arrays),
-        ``action_points`` (list of int64 arrays: 0-based frame of each action
-        point), ``action_classes`` (list of int64 arrays: its class 1..12),
-        ``timestamps`` (list of int64 arrays, microseconds), ``sample_ids``
-        (file stems such as ``"P3_1_1_p01"``), ``groups`` (subject number, int),
-        ``fps`` (30.0), ``n_frames``, ``missing``, ``target_names``, ``layout``
-        and ``DESCR``. Sequences are sorted by subject, then gesture.
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys ``X`` (list of (n_frames_i, 20, 3) float64
+        arrays, metres, Kinect v1 NUI order; the ``w`` column is dropped), ``y`` (all
+        zeros: no intervals are annotated), ``segments`` (empty (0, 3) arrays),
+        ``action_points`` (list of int64 arrays: 0-based frame of each action point),
+        ``action_classes`` (list of int64 arrays: its class 1..12), ``timestamps`` (list
+        of int64 arrays, microseconds), ``sample_ids`` (file stems such as
+        ``"P3_1_1_p01"``), ``groups`` (subject number, int), ``fps`` (30.0),
+        ``n_frames``, ``missing``, ``target_names``, ``layout`` and ``DESCR``. Sequences
+        are sorted by subject, then gesture.
 
     Raises
     ------
@@ -303,6 +306,9 @@ def _parse_utk_labels(text, name):
 def load_utkinect(path, *, labels="original"):
     """Load the UTKinect-Action3D skeletons with their action intervals.
 
+    Continuous streams of 10 whole-body actions in a fixed order; the start/end
+    labels, given in video frame numbers, are mapped to skeleton rows.
+
     Parameters
     ----------
     path : str or path-like
@@ -314,15 +320,15 @@ def load_utkinect(path, *, labels="original"):
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
-        With keys ``X`` (list of (n_rows_i, 20, 3) float64 arrays, metres,
-        Kinect v1 NUI order), ``y`` (per-row int64 labels, 0 = unlabelled,
-        1..10), ``segments`` (rows ``(class, start, end)`` over row indices,
-        0-based, end exclusive, sorted by start), ``frame_numbers`` (list of
-        int64 arrays: video frame of each row), ``sample_ids`` (``"s01_e01"``,
-        ...), ``groups`` (subject, int), ``fps`` (ndarray: mean skeleton rows
-        per second of each sequence, from the 30 fps frame numbers),
-        ``n_frames``, ``missing``, ``target_names``, ``layout`` and ``DESCR``.
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys ``X`` (list of (n_rows_i, 20, 3) float64
+        arrays, metres, Kinect v1 NUI order), ``y`` (per-row int64 labels, 0 =
+        unlabelled, 1..10), ``segments`` (rows ``(class, start, end)`` over row indices,
+        0-based, end exclusive, sorted by start), ``frame_numbers`` (list of int64
+        arrays: video frame of each row), ``sample_ids`` (``"s01_e01"``, ...),
+        ``groups`` (subject, int), ``fps`` (ndarray: mean skeleton rows per second of
+        each sequence, from the 30 fps frame numbers), ``n_frames``, ``missing``,
+        ``target_names``, ``layout`` and ``DESCR``.
 
     Raises
     ------
@@ -520,6 +526,9 @@ def _parse_msr_clip(text, name):
 def load_msr_action3d(path, *, subset="cvpr12"):
     """Load the MSR Action3D skeleton clips (isolated actions).
 
+    Each clip is one pre-segmented action; its joints are reordered from the MSR
+    order to the Kinect v1 NUI order.
+
     Parameters
     ----------
     path : str or path-like
@@ -532,15 +541,15 @@ def load_msr_action3d(path, *, subset="cvpr12"):
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
-        With keys ``X`` (list of (n_frames_i, 20, 3) float64 arrays, metres,
-        reordered to Kinect v1 NUI order), ``y`` (the clip's action 1..20 on
-        every frame), ``segments`` (one row ``(action, 0, n_frames_i)`` per clip),
-        ``joint_confidence`` (list of (n_frames_i, 20) arrays: the 4th value),
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys ``X`` (list of (n_frames_i, 20, 3) float64
+        arrays, metres, reordered to Kinect v1 NUI order), ``y`` (the clip's action
+        1..20 on every frame), ``segments`` (one row ``(action, 0, n_frames_i)`` per
+        clip), ``joint_confidence`` (list of (n_frames_i, 20) arrays: the 4th value),
         ``sample_ids`` (``"a01_s01_e01"``, ...), ``groups`` (subject, int),
         ``repetitions`` (ZZ, int), ``fps`` (15.0), ``n_frames``, ``missing``,
-        ``target_names``, ``layout`` and ``DESCR``. Clips are sorted by action,
-        subject, repetition.
+        ``target_names``, ``layout`` and ``DESCR``. Clips are sorted by action, subject,
+        repetition.
 
     Raises
     ------

@@ -193,14 +193,14 @@ def load_precog(path=None, *, subjects=None):
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
-        With keys ``X`` (list of (n_frames_i, 20, 3) float64 arrays, metres,
-        Kinect v1 NUI order), ``y`` (per-frame int64 labels, 0 = no action,
-        1..8), ``segments`` (runs of non-zero labels, rows ``(class, start,
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys ``X`` (list of (n_frames_i, 20, 3) float64
+        arrays, metres, Kinect v1 NUI order), ``y`` (per-frame int64 labels, 0 = no
+        action, 1..8), ``segments`` (runs of non-zero labels, rows ``(class, start,
         end)`` 0-based with exclusive end), ``sample_ids`` (``"Seq1_1"``, ...),
-        ``groups`` (subject of each sequence, int), ``scripts`` (script 1-6),
-        ``fps`` (30.0), ``n_frames``, ``missing``, ``target_names``, ``layout``
-        and ``DESCR``. Sequences are sorted by subject, then script.
+        ``groups`` (subject of each sequence, int), ``scripts`` (script 1-6), ``fps``
+        (30.0), ``n_frames``, ``missing``, ``target_names``, ``layout`` and ``DESCR``.
+        Sequences are sorted by subject, then script.
 
     Raises
     ------

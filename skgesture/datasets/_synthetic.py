@@ -6,17 +6,15 @@ motions) and turns them into joint positions with one forward-kinematics pass
 vectorised over the frames. Timing statistics follow the LAP 2014 Track 3
 validation labels (``shared/data/chalearn_montalbano/PROVENANCE.md``).
 
-Design notes
-------------
-* Gesture classes are fixed: the prototypes come from a private random
-  generator with a constant seed, so ``gesture_05`` is the same motion whatever
-  ``random_state`` is. Streams drawn with two seeds can therefore serve as a
-  training and a test set.
-* Only the structure of a stream (subjects, timeline, keyframes) is drawn from
-  the ``RandomState``; the bulk sensor noise and the per-frame dropout draws
-  come from a :class:`numpy.random.Generator` seeded from it, which is several
-  times faster for ~10^8 normal variates and keeps one ``random_state`` in
-  control of everything.
+Two design choices are worth knowing. Gesture classes are fixed: the class
+prototypes come from a private generator with a constant seed, so
+``gesture_05`` is the same motion whatever ``random_state`` is, and streams
+drawn with two seeds can serve as a training and a test set. And only the
+structure of a stream (subjects, timeline, keyframes) is drawn from the
+``RandomState`` given by the user; the bulk sensor noise and the per-frame
+dropout draws come from a :class:`numpy.random.Generator` seeded from it, which
+is faster for ~10^8 normal variates and keeps one ``random_state`` in control
+of everything.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -61,6 +59,14 @@ PROTOTYPE_SEED = 20140906  # fixed: classes do not depend on random_state
 SIMILAR_PAIRS = ((14, 15), (5, 6))
 SIMILAR_DELTA_DEG = (-12.0, 0.0, 0.0, 28.0, 20.0)  # change of the last pose
 MIN_PROTOTYPE_DISTANCE = 0.30  # metres, between hand-trajectory descriptors
+# (kind, weight): one-handed (right arm; the left arm of left-handed subjects),
+# both arms mirror-symmetric, both arms independent, the arms taking turns.
+PROTOTYPE_KINDS = (("right", 3), ("mirror", 1), ("both", 1), ("alternate", 1))
+N_POSES_RANGE = (2, 5)  # distinct poses of a class, high end exclusive
+REPEAT_RATE = 0.3  # fraction of classes that go to and fro between two poses
+REPEAT_POSES = 2
+MIRROR_JITTER_DEG = 4.0  # how far the two arms of a "mirror" class differ
+PROTOTYPE_TIME_JITTER = 0.03  # of the evenly spaced pose times
 LEFT_HANDED_RATE = 0.1  # fraction of subjects who gesture with the left hand
 
 # --- skeleton, body frame: x = subject's left, y = up, z = away from the sensor,
@@ -79,11 +85,6 @@ RIGID_BONES = (
     ("AnkleLeft", "KneeLeft", 0.33, (0.07, -0.96, 0.25)),
     ("FootLeft", "AnkleLeft", 0.10, (0.0, -0.55, -0.83)),
 )
-UPPER_BODY = (
-    "Spine", "ShoulderCenter", "Head",
-    "ShoulderLeft", "ElbowLeft", "WristLeft", "HandLeft",
-    "ShoulderRight", "ElbowRight", "WristRight", "HandRight",
-)  # fmt: skip
 BODY_SCALE_LOG_SD = 0.06  # overall body size
 BONE_SCALE_LOG_SD = 0.04  # each bone on top of it
 
@@ -91,11 +92,12 @@ BONE_SCALE_LOG_SD = 0.04  # each bone on top of it
 # columns 0-4 are the left arm, 5-9 the right arm.
 N_ARM_ANGLES = 5
 N_ANGLES = 2 * N_ARM_ANGLES
+_LEFT, _RIGHT = slice(0, N_ARM_ANGLES), slice(N_ARM_ANGLES, N_ANGLES)
 REST_DOWN_DEG = (8.0, 14.0, 10.0, 18.0, 5.0)  # arms hanging
 REST_CLASPED_DEG = (15.0, 5.0, 40.0, 80.0, 10.0)  # hands held before the belly
 CLASPED_REST_RATE = 0.25  # fraction of subjects resting with clasped hands
 GESTURE_LOW_DEG = (20.0, -10.0, -30.0, 20.0, -30.0)  # prototype pose range
-GESTURE_HIGH_DEG = (140.0, 60.0, 70.0, 140.0, 40.0)
+GESTURE_HIGH_DEG = (120.0, 60.0, 70.0, 130.0, 40.0)
 JOINT_LIMITS_DEG = (
     (-20.0, -20.0, -80.0, 0.0, -60.0),
     (175.0, 120.0, 90.0, 150.0, 60.0),
@@ -103,13 +105,13 @@ JOINT_LIMITS_DEG = (
 MIN_PEAK_FLEXION_DEG = 45.0  # every gesture raises the arm at least this much
 
 # --- per-instance variation
-KEY_JITTER_DEG = 9.0  # std of each pose angle of a gesture instance
+KEY_JITTER_DEG = 15.0  # std of each pose angle of a gesture instance
 KEY_TIME_JITTER = 0.015  # std of keyframe times, as a fraction of the gesture
 TIME_WARP = 0.4  # largest |a| of the monotone time warp u + a u (1 - u)
 KEY_TIME_LIMITS = (0.03, 0.97)  # poses stay strictly inside the gesture
-AMPLITUDE_LOG_SD = 0.12  # per instance, scales the pose's distance from rest
+AMPLITUDE_LOG_SD = 0.15  # per instance, scales the pose's distance from rest
 SUBJECT_AMPLITUDE_LOG_SD = 0.08
-KEY_TIME_RANGE = (0.12, 0.88)  # first/last pose times within a gesture
+KEY_TIME_RANGE = (0.18, 0.82)  # first/last pose times within a gesture
 MIN_KEY_SEPARATION = 0.02  # between pose times, as a fraction of the gesture
 FIT_GESTURE_SHARE = 0.7  # with a fixed n_frames, gestures fill at most this share
 
@@ -140,12 +142,12 @@ OOV_MARGIN = 4  # frames of rest kept on each side of it
 OOV_LEN_MEDIAN, OOV_LEN_LOG_SD, OOV_LEN_MIN = 28.0, 0.3, 8
 OOV_AMPLITUDE = (0.4, 1.0)  # fraction of a random pose's distance from rest
 OOV_ARM_PROBS = (0.3, 0.5, 0.2)  # left arm, right arm, both
+OOV_N_KEYS_RANGE = (1, 4)  # poses of one motion, high end exclusive
 OOV_KEY_RANGE = (0.2, 0.8)  # pose times within the motion
 
 # --- placement in front of the sensor (camera space, metres / degrees)
-ROOT_X_RANGE = (-0.3, 0.3)
-ROOT_Y_RANGE = (-0.15, 0.35)
-ROOT_Z_RANGE = (2.0, 3.0)
+ROOT_LOW = (-0.3, -0.15, 2.0)  # HipCenter x, y, z: uniform between these
+ROOT_HIGH = (0.3, 0.35, 3.0)  # (z = 2-3 m, as in the Montalbano recordings)
 YAW_SD_DEG, YAW_MAX_DEG = 10.0, 25.0
 CAMERA_PITCH_MAX_DEG = 4.0
 
@@ -158,7 +160,9 @@ _J = {name: i for i, name in enumerate(KINECT_V1.joint_names)}
 # contiguous in the NUI order, so slices replace fancy indexing.
 _UPPER = slice(_J["Spine"], _J["HandRight"] + 1)
 _ARMS = {s: slice(_J[f"Elbow{s}"], _J[f"Hand{s}"] + 1) for s in ("Left", "Right")}
-_STILL = np.array([j for j in range(N_KINECT_JOINTS) if not _UPPER.start <= j < _UPPER.stop])
+_STILL = np.array(
+    [j for j in range(N_KINECT_JOINTS) if not _UPPER.start <= j < _UPPER.stop]
+)  # HipCenter and the legs
 _CANONICAL_REST = np.tile(np.radians(REST_DOWN_DEG), 2)
 _LIMIT_LOW, _LIMIT_HIGH = (np.tile(np.radians(lim), 2) for lim in JOINT_LIMITS_DEG)
 _BONE_TYPES = tuple(b[0].replace("Left", "") for b in RIGID_BONES) + (
@@ -225,7 +229,9 @@ def _rotation(pitch, roll, yaw):
     ndarray of shape (..., 3, 3)
         The rotation matrices.
     """
-    pitch, roll, yaw = np.broadcast_arrays(*(np.asarray(a, float) for a in (pitch, roll, yaw)))
+    pitch, roll, yaw = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (pitch, roll, yaw))
+    )
     cp, sp = np.cos(pitch), np.sin(pitch)
     cr, sr = np.cos(roll), np.sin(roll)
     cy, sy = np.cos(yaw), np.sin(yaw)
@@ -263,7 +269,7 @@ def _rest_skeleton(bone_scale):
     return pos
 
 
-def _forward_kinematics(arm_angles, torso_angles, body, root_rot, root_pos):
+def _forward_kinematics(arm_angles, torso_angles, body, root_rot, root_pos, out=None):
     """Joint positions in camera space of one stream, vectorised over frames.
 
     Parameters
@@ -278,32 +284,35 @@ def _forward_kinematics(arm_angles, torso_angles, body, root_rot, root_pos):
         Body-to-camera rotation (subject yaw and sensor tilt).
     root_pos : ndarray of shape (n_frames, 3)
         HipCenter position in camera space.
+    out : ndarray of shape (n_frames, 20, 3) or None, default=None
+        If given, the positions are added to it in place (the sensor noise).
 
     Returns
     -------
     ndarray of shape (n_frames, 20, 3)
-        Joint positions.
+        Joint positions (``out`` when given).
     """
     n = len(arm_angles)
     rest = body["rest"]
     upper = np.empty((n, _UPPER.stop - _UPPER.start, N_COORDS))
     upper[:] = rest[_UPPER]
-    for side, cols, sign in (("Left", slice(0, 5), 1.0), ("Right", slice(5, 10), -1.0)):
+    for side, cols, sign in (("Left", _LEFT, 1.0), ("Right", _RIGHT, -1.0)):
         arm = slice(_ARMS[side].start - _UPPER.start, _ARMS[side].stop - _UPPER.start)
         off = _arm_offsets(arm_angles[:, cols], body["arm_lengths"])
         off[..., 0] *= sign  # a right arm mirrors the canonical left arm
         upper[:, arm] = rest[_J[f"Shoulder{side}"]] + off
     # the torso sways about HipCenter (the origin), then the body is placed
     rot = root_rot @ _rotation(*torso_angles.T)
-    out = np.empty((n, N_KINECT_JOINTS, N_COORDS))
+    if out is None:
+        out = np.zeros((n, N_KINECT_JOINTS, N_COORDS))
     for i in range(N_COORDS):
-        out[:, _UPPER, i] = (
+        out[:, _UPPER, i] += (
             rot[:, i, 0, None] * upper[..., 0]
             + rot[:, i, 1, None] * upper[..., 1]
             + rot[:, i, 2, None] * upper[..., 2]
+            + root_pos[:, i, None]
         )
-    out[:, _STILL] = rest[_STILL] @ root_rot.T
-    out += root_pos[:, None, :]
+    out[:, _STILL] += rest[_STILL] @ root_rot.T + root_pos[:, None, :]
     return out
 
 
@@ -320,26 +329,27 @@ def _random_pose(rng, size=()):
 
 def _draw_prototype(rng):
     """One class: keyframe poses (NaN on an idle arm), times, length factor."""
-    kind = rng.choice(["right", "right", "right", "sym", "asym", "alternate"])
-    repeat = rng.rand() < 0.3
-    n_poses = 2 if repeat else rng.randint(2, 5)
+    kinds, weights = zip(*PROTOTYPE_KINDS)
+    kind = kinds[rng.choice(len(kinds), p=np.array(weights) / sum(weights))]
+    repeat = rng.rand() < REPEAT_RATE
+    n_poses = REPEAT_POSES if repeat else rng.randint(*N_POSES_RANGE)
     right = _random_pose(rng, n_poses)
     while np.degrees(right[:, 0].max()) < MIN_PEAK_FLEXION_DEG:
         right = _random_pose(rng, n_poses)
     if kind == "right":
         left = np.full_like(right, np.nan)
-    elif kind == "sym":
-        left = right + np.radians(rng.normal(0, 4.0, right.shape))
-    elif kind == "asym":
+    elif kind == "mirror":
+        left = right + np.radians(rng.normal(0.0, MIRROR_JITTER_DEG, right.shape))
+    elif kind == "both":
         left = _random_pose(rng, n_poses)
-    else:  # the arms take turns
+    else:  # "alternate": the arms take turns
         left = np.roll(right, 1, axis=0)
     keys = np.concatenate([left, right], axis=1)
     if repeat:  # a to-and-fro motion: A B A B
         keys = np.concatenate([keys, keys], axis=0)
     n_keys = len(keys)
     times = np.linspace(*KEY_TIME_RANGE, n_keys)
-    times = times + rng.uniform(-0.03, 0.03, n_keys)
+    times += rng.uniform(-PROTOTYPE_TIME_JITTER, PROTOTYPE_TIME_JITTER, n_keys)
     log_len = rng.normal(0.0, CLASS_LEN_LOG_SD)
     return {"keys": keys, "times": np.sort(times), "log_len": log_len}
 
@@ -353,7 +363,7 @@ def _prototype_descriptor(proto):
     k = np.vstack([rest, keys, rest])
     ang = np.stack([np.interp(grid, t, k[:, j]) for j in range(N_ANGLES)], axis=1)
     hands = []
-    for cols in (slice(0, 5), slice(5, 10)):
+    for cols in (_LEFT, _RIGHT):
         hands.append(_arm_offsets(ang[:, cols], ARM_LENGTHS)[:, 2])
     return np.concatenate(hands, axis=1).ravel()
 
@@ -396,9 +406,7 @@ def _prototypes():
 def _draw_subject(rng):
     """Body, rest pose, handedness, speed and amplitude of one subject."""
     size = np.exp(rng.normal(0.0, BODY_SCALE_LOG_SD))
-    scale = {
-        b: size * np.exp(rng.normal(0.0, BONE_SCALE_LOG_SD)) for b in _BONE_TYPES
-    }
+    scale = {b: size * np.exp(rng.normal(0.0, BONE_SCALE_LOG_SD)) for b in _BONE_TYPES}
     clasped = rng.rand() < CLASPED_REST_RATE
     rest_arm = np.radians(REST_CLASPED_DEG if clasped else REST_DOWN_DEG)
     return {
@@ -415,6 +423,7 @@ def _draw_subject(rng):
 
 
 def _lognormal_frames(rng, median, log_sd, size, scale):
+    """Log-normal durations in frames, rounded, at ``scale`` times 20 fps."""
     return np.rint(np.exp(rng.normal(np.log(median), log_sd, size)) * scale)
 
 
@@ -439,7 +448,8 @@ def _draw_timeline(rng, classes, subject, scale, oov_rate, n_frames=None):
     lengths = np.clip(np.rint(GESTURE_LEN_MEDIAN * scale * np.exp(log_len)), lo, hi)
     gaps = _lognormal_frames(rng, GAP_POSITIVE_MEDIAN, GAP_LOG_SD, n_g - 1, scale)
     gaps = np.clip(gaps, 1, max(1, round(GAP_MAX * scale)))
-    gaps[rng.rand(n_g - 1) < GAP_ZERO_PROB] = 0
+    # back-to-back gestures, but never two of one class: labels would merge them
+    gaps[(rng.rand(n_g - 1) < GAP_ZERO_PROB) & (classes[1:] != classes[:-1])] = 0
     edge_min = max(1, round(EDGE_REST_MIN * scale))
     lead = np.clip(
         _lognormal_frames(rng, LEAD_MEDIAN, LEAD_LOG_SD, 1, scale),
@@ -456,12 +466,13 @@ def _draw_timeline(rng, classes, subject, scale, oov_rate, n_frames=None):
 
     oov = {}
     margin = max(1, round(OOV_MARGIN * scale))
-    eligible = np.flatnonzero(rests >= OOV_MIN_REST * scale)
+    min_len = max(2, round(OOV_LEN_MIN * scale))
+    eligible = np.flatnonzero(rests >= max(OOV_MIN_REST * scale, 2 * margin + min_len))
     n_oov = min(rng.binomial(n_g, oov_rate), len(eligible))
     for r in np.sort(rng.choice(eligible, n_oov, replace=False)):
         room = rests[r] - 2 * margin
         length = _lognormal_frames(rng, OOV_LEN_MEDIAN, OOV_LEN_LOG_SD, None, scale)
-        length = int(np.clip(length, min(room, OOV_LEN_MIN * scale), room))
+        length = int(np.clip(length, min_len, room))
         offset = margin + rng.randint(0, room - length + 1)
         oov[int(r)] = (offset, length)
     return lengths, rests, oov
@@ -551,18 +562,19 @@ def _rest_keys(starts, stops, subject, rng, spacing):
 
 def _oov_keys(start, length, subject, rng):
     """Keyframes of a random arm motion that belongs to no class."""
-    n_keys = rng.randint(1, 4)
+    n_keys = rng.randint(*OOV_N_KEYS_RANGE)
     rest = np.broadcast_to(subject["rest"], (n_keys, N_ANGLES))
     amp = rng.uniform(*OOV_AMPLITUDE, size=(n_keys, 1))
     target = np.concatenate([_random_pose(rng, n_keys), _random_pose(rng, n_keys)], 1)
     poses = rest + amp * (target - rest)
     arms = rng.choice(["left", "right", "both"], p=OOV_ARM_PROBS)
     if arms != "both":
-        idle = slice(5, 10) if arms == "left" else slice(0, 5)
+        idle = _RIGHT if arms == "left" else _LEFT
         poses[:, idle] = rest[:, idle] + np.radians(
             rng.normal(0.0, REST_JITTER_DEG, (n_keys, N_ARM_ANGLES))
         )
-    u = np.sort(rng.uniform(*OOV_KEY_RANGE, n_keys)) + np.arange(n_keys) * 1e-3
+    u = np.sort(rng.uniform(*OOV_KEY_RANGE, n_keys))
+    u += np.arange(n_keys) * MIN_KEY_SEPARATION / 10  # strictly increasing
     return start + u * length, poses
 
 
@@ -586,8 +598,18 @@ def _sway(rng, seconds):
     return arm, torso, root
 
 
-def _make_stream(classes, subject, rng, noise_rng, *, fps, oov_rate, noise,
-                 dropout_rate, n_frames=None):
+def _make_stream(
+    classes,
+    subject,
+    rng,
+    noise_rng,
+    *,
+    fps,
+    oov_rate,
+    noise,
+    dropout_rate,
+    n_frames=None,
+):
     """One sequence: positions, labels, segments and missing mask."""
     scale = fps / REFERENCE_FPS
     lengths, rests, oov = _draw_timeline(
@@ -625,13 +647,16 @@ def _make_stream(classes, subject, rng, noise_rng, *, fps, oov_rate, noise,
     arm_sway, torso, root_sway = _sway(rng, frames / fps)
     arm += arm_sway
 
-    root = np.array([rng.uniform(*r) for r in (ROOT_X_RANGE, ROOT_Y_RANGE, ROOT_Z_RANGE)])
+    root = rng.uniform(ROOT_LOW, ROOT_HIGH)
     yaw = np.radians(np.clip(rng.normal(0.0, YAW_SD_DEG), -YAW_MAX_DEG, YAW_MAX_DEG))
     pitch = np.radians(rng.uniform(-CAMERA_PITCH_MAX_DEG, CAMERA_PITCH_MAX_DEG))
     root_rot = _rotation(pitch, 0.0, 0.0) @ _rotation(0.0, 0.0, yaw)
-    X = _forward_kinematics(arm, torso, subject["body"], root_rot, root + root_sway)
+    # the noise is drawn first and the kinematics adds into it (one pass less)
+    X = np.zeros((n_total, N_KINECT_JOINTS, N_COORDS))
     if noise > 0:
-        X += noise * noise_rng.standard_normal(X.shape, dtype=np.float32)
+        noise_rng.standard_normal(out=X)
+        X *= noise
+    _forward_kinematics(arm, torso, subject["body"], root_rot, root + root_sway, X)
 
     missing = np.zeros(n_total, dtype=bool)
     if dropout_rate > 0:
@@ -664,7 +689,9 @@ def _check_real(value, name, low, high, *, low_open=False):
         raise ValueError(f"{name} must be a finite real number, got {value!r}")
     if value < low or (low_open and value == low) or value > high:
         op = "<" if low_open else "<="
-        raise ValueError(f"{name} must satisfy {low} {op} {name} <= {high}, got {value}")
+        raise ValueError(
+            f"{name} must satisfy {low} {op} {name} <= {high}, got {value}"
+        )
     return float(value)
 
 
@@ -686,8 +713,9 @@ def _check_n_gestures(n_gestures):
     return lo, hi
 
 
-def _check_params(n_sequences, n_classes, n_gestures, n_subjects, oov_rate, noise,
-                  dropout_rate, fps):
+def _check_params(
+    n_sequences, n_classes, n_gestures, n_subjects, oov_rate, noise, dropout_rate, fps
+):
     n_sequences = _check_int(n_sequences, "n_sequences", 1)
     n_classes = _check_int(n_classes, "n_classes", 1, MAX_CLASSES)
     n_gestures = _check_n_gestures(n_gestures)
@@ -698,8 +726,16 @@ def _check_params(n_sequences, n_classes, n_gestures, n_subjects, oov_rate, nois
     noise = _check_real(noise, "noise", 0.0, 1.0)
     dropout_rate = _check_real(dropout_rate, "dropout_rate", 0.0, 0.5)
     fps = _check_real(fps, "fps", 0.0, 1000.0, low_open=True)
-    return (n_sequences, n_classes, n_gestures, n_subjects, oov_rate, noise,
-            dropout_rate, fps)
+    return (
+        n_sequences,
+        n_classes,
+        n_gestures,
+        n_subjects,
+        oov_rate,
+        noise,
+        dropout_rate,
+        fps,
+    )
 
 
 _DESCR = """\
@@ -782,7 +818,7 @@ def make_gesture_streams(
 
     Returns
     -------
-    data : :class:`~sklearn.utils.Bunch`
+    :class:`~sklearn.utils.Bunch`
         Dictionary-like object with the keys of the real loaders:
 
         X : list of ndarray of shape (n_frames_i, 20, 3)
@@ -824,8 +860,10 @@ def make_gesture_streams(
     gestures): gesture length is a log-normal with median 39 frames (per-class,
     per-subject and per-instance factors) clipped to 6-96; 8.6 % of the gaps
     are 0 and the others log-normal with median 30, so the median gap is about
-    27; lead-in and tail rests have medians 44 and 32. Classes are drawn
-    balanced over the whole data set; a class may occur twice in a sequence.
+    27; lead-in and tail rests have medians 44 and 32. Classes are balanced
+    over the whole data set (counts differ by at most one) and distinct within
+    a sequence, unless it has more gestures than there are classes; two
+    instances of one class are always separated by a rest.
 
     Each class is a few keyframe poses of flexion, abduction and twist of the
     shoulders, elbow and wrist flexion, interpolated with monotone cubic
@@ -866,21 +904,50 @@ def make_gesture_streams(
     )  # fmt: skip
 
 
-def _generate(rng, *, n_sequences, n_classes, n_gestures, n_subjects, oov_rate,
-              noise, dropout_rate, fps, return_segments=True, n_frames=None):
+def _draw_classes(n_gestures, drawn, rng):
+    """Classes of one sequence, balanced over the data set.
+
+    Each sequence takes the classes drawn least so far (ties broken at random),
+    all distinct unless it holds more gestures than there are classes, and
+    performs them in random order. ``drawn`` is updated in place.
+    """
+    n_classes = len(drawn)
+    chosen = []
+    while n_gestures > 0:
+        k = min(n_gestures, n_classes)
+        order = rng.permutation(n_classes)
+        pick = order[np.argsort(drawn[order], kind="stable")[:k]]
+        drawn[pick] += 1
+        chosen.append(pick + 1)
+        n_gestures -= k
+    return rng.permutation(np.concatenate(chosen))
+
+
+def _generate(
+    rng,
+    *,
+    n_sequences,
+    n_classes,
+    n_gestures,
+    n_subjects,
+    oov_rate,
+    noise,
+    dropout_rate,
+    fps,
+    return_segments=True,
+    n_frames=None,
+):
     """The generator behind :func:`make_gesture_streams`, on validated input."""
     noise_rng = np.random.default_rng(rng.randint(np.iinfo(np.int32).max))
     subjects = [_draw_subject(rng) for _ in range(n_subjects)]
     groups = rng.permutation(np.arange(n_sequences) % n_subjects)
     counts = rng.randint(n_gestures[0], n_gestures[1] + 1, size=n_sequences)
-    n_rounds = -(-counts.sum() // n_classes)
-    pool = np.concatenate([rng.permutation(n_classes) + 1 for _ in range(n_rounds)])
-    bounds = np.concatenate([[0], np.cumsum(counts)])
+    drawn = np.zeros(n_classes, dtype=np.int64)  # instances of each class so far
 
     X, y, segments, missing = [], [], [], []
     for i in range(n_sequences):
         xi, yi, si, mi = _make_stream(
-            pool[bounds[i] : bounds[i + 1]], subjects[groups[i]], rng, noise_rng,
+            _draw_classes(counts[i], drawn, rng), subjects[groups[i]], rng, noise_rng,
             fps=fps, oov_rate=oov_rate, noise=noise, dropout_rate=dropout_rate,
             n_frames=n_frames,
         )  # fmt: skip

@@ -2,12 +2,15 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from skgesture.utils._resize import imresize_weights, resize_frames
+from skgesture.utils._scg import SCG
 from skgesture.utils._segments import (
     labels_to_segments,
     remove_short_runs,
     runs,
     segments_to_labels,
 )
+from skgesture.utils._smoothing import loess_kernel, loess_smooth
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -22,4 +25,9 @@ __all__ = [
     "segments_to_labels",
     "runs",
     "remove_short_runs",
+    "loess_smooth",
+    "loess_kernel",
+    "resize_frames",
+    "imresize_weights",
+    "SCG",
 ]

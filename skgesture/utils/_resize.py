@@ -1,4 +1,4 @@
-"""Resampling of a frame matrix along time (MATLAB ``imresize`` bicubic, pchip, spline)."""
+"""Resample frame matrices along time: MATLAB ``imresize`` bicubic, pchip, spline."""
 
 # SPDX-License-Identifier: BSD-3-Clause
 

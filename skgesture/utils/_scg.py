@@ -1,4 +1,4 @@
-"""Scaled Conjugate Gradient (Møller 1993) as MATLAB ``trainscg``, as a torch optimiser."""
+"""Scaled Conjugate Gradient as MATLAB ``trainscg`` (Møller 1993), a torch optimiser."""
 
 # SPDX-License-Identifier: BSD-3-Clause
 
@@ -70,10 +70,16 @@ class SCG(Optimizer):
         first closure call of a step (the loss skorch records) return
         ``E(w)``. If False the loss and gradient computed at the accepted
         point of the previous step are reused (MATLAB's 2 and 1
-        evaluations); use it only with full-batch training.
+        evaluations, same iterates in full-batch training); use it only with
+        full-batch training, and note that the first closure call of a step
+        is then at ``w + σk p`` or at a trial point, so the loss skorch
+        records is not exactly ``E(w)``.
 
     Attributes
     ----------
+    grad_norm : float or None
+        ``‖∇E‖`` at the current weights after the last step, for MATLAB's
+        ``min_grad`` stopping rule (same as ``info["grad_norm"]``).
     info : dict
         Read-only view of the scalar state after the last step: ``n_iter``
         (steps taken), ``n_accepted``, ``n_rejected``, ``n_evals`` (closure
@@ -179,6 +185,11 @@ class SCG(Optimizer):
         state = self.state[params[0]] if params else {}
         return {key: state.get(key) for key in _INFO_KEYS}
 
+    @property
+    def grad_norm(self):
+        """``‖∇E‖`` at the current weights after the last step (None before)."""
+        return self.info["grad_norm"]
+
     @staticmethod
     def _gather(params, dtype, device):
         return torch.cat(
@@ -222,6 +233,7 @@ class SCG(Optimizer):
         if loss is None:
             raise ValueError("The SCG closure must return the loss, got None.")
         state["n_evals"] += 1
+        loss = torch.as_tensor(loss).detach()
         return loss, float(loss), self._gather_grad(params, dtype, device)
 
     # --------------------------------------------------------------------- step
@@ -239,7 +251,7 @@ class SCG(Optimizer):
         Returns
         -------
         loss : torch.Tensor
-            The loss at the weights the step started from.
+            The loss at the weights the step started from (detached).
         """
         if closure is None:
             raise ValueError(

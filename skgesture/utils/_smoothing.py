@@ -16,9 +16,7 @@ _DEGREES = {"loess": 2, "lowess": 1}  # METHOD_SPEC §8.1 step 2
 
 def _check_method(method):
     if method not in _DEGREES:
-        raise ValueError(
-            f"method must be 'loess' or 'lowess', got {method!r}."
-        )
+        raise ValueError(f"method must be 'loess' or 'lowess', got {method!r}.")
     return _DEGREES[method]
 
 

@@ -1,0 +1,75 @@
+"""Shared helpers of the benchmarks: timing, tables, one-core execution."""
+
+import os
+import statistics
+import time
+from contextlib import contextmanager
+
+
+def median_time(func, repeat=5, warmup=1):
+    """Median wall time of ``func()`` over ``repeat`` runs, after ``warmup`` runs."""
+    for _ in range(warmup):
+        func()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), times
+
+
+@contextmanager
+def one_core():
+    """Limit numpy/BLAS and torch to one thread inside the block."""
+    import torch
+    from threadpoolctl import threadpool_limits
+
+    old = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        with threadpool_limits(1):
+            yield
+    finally:
+        torch.set_num_threads(old)
+
+
+def format_table(rows, columns=None, title=None):
+    """Markdown table of a list of dicts (floats rounded sensibly)."""
+    if not rows:
+        return f"## {title}\n\n(no rows)\n" if title else "(no rows)\n"
+    columns = columns or list(rows[0])
+
+    def fmt(v):
+        if isinstance(v, float):
+            if v != v:
+                return "nan"
+            if abs(v) >= 1000:
+                return f"{v:,.0f}"
+            if abs(v) >= 10:
+                return f"{v:.1f}"
+            return f"{v:.3f}"
+        return str(v)
+
+    lines = []
+    if title:
+        lines += [f"## {title}", ""]
+    lines.append("| " + " | ".join(columns) + " |")
+    lines.append("|" + "|".join("---" for _ in columns) + "|")
+    for r in rows:
+        lines.append("| " + " | ".join(fmt(r.get(c, "")) for c in columns) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def machine_line():
+    """One line describing where the numbers were taken."""
+    import platform
+
+    import numpy
+    import sklearn
+    import torch
+
+    return (
+        f"{platform.node()} · {os.cpu_count()} cores · Python {platform.python_version()}"
+        f" · numpy {numpy.__version__} · scikit-learn {sklearn.__version__}"
+        f" · torch {torch.__version__}"
+    )

@@ -1,0 +1,806 @@
+"""BiLSTMTagger: framewise bidirectional LSTM tagger of every frame (Method C)."""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from numbers import Integral, Real
+
+import numpy as np
+import torch
+from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
+from sklearn.utils import check_random_state
+from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
+from sklearn.utils.validation import check_is_fitted
+from skorch import NeuralNet
+from skorch.callbacks import EarlyStopping, LRScheduler
+from torch import nn
+from torch.nn import functional as F
+
+from skgesture._networks import fit_cached, seed_from
+from skgesture.utils._segments import labels_to_segments, remove_short_runs
+from skgesture.utils._smoothing import loess_smooth
+from skgesture.utils._validation import check_sequence_labels, check_sequences
+
+__all__ = ["BiLSTMTagger", "sample_windows"]
+
+# METHOD_SPEC §7.1: training windows
+WINDOW = 10
+REST_STEP = 5
+GESTURE_STEP = 2
+# METHOD_SPEC §7.2: network
+LEAKY_SLOPE = 0.01
+PAPER_HIDDEN_SIZES = (1024, 1024, 512)
+PAPER_DROPOUT = 0.6
+# METHOD_SPEC §7.3: optimiser and schedule
+LEARNING_RATE = 0.01
+MOMENTUM = 0.9
+WEIGHT_DECAY = 1e-4
+LR_DROP_FACTOR = 0.85
+LR_DROP_PERIOD = 10
+BATCH_SIZE = 128
+PAPER_MAX_EPOCHS = 150
+# METHOD_SPEC §7.4 and decision D12: decision rules
+MIN_RUN = 15
+SMOOTH_SPAN = 15
+# CPU-sized default network (measured in the BiLSTMTagger Notes)
+CPU_HIDDEN_SIZES = (64, 64)
+CPU_DROPOUT = 0.3
+CPU_MAX_EPOCHS = 40
+
+VALIDATION_FRACTION = 0.1
+N_ITER_NO_CHANGE = 10
+IGNORE_INDEX = -100  # padded frames of a training sequence shorter than a window
+PREDICT_BATCH = 4096  # chunks per forward pass at prediction
+
+
+def sample_windows(y, window=WINDOW, rest_step=REST_STEP, gesture_step=GESTURE_STEP):
+    """Start frames of the training windows of one sequence (METHOD_SPEC §7.1).
+
+    The first window starts at frame 0. After the window starting at ``t``, the
+    next one starts at ``t + rest_step`` if all its ``window`` frames are rest
+    (label 0), else at ``t + gesture_step``; windows that would run past the end
+    are not taken. A sequence shorter than ``window`` gives the single start 0
+    (one shorter window).
+
+    Parameters
+    ----------
+    y : array-like of shape (n_frames,)
+        Per-frame labels of the sequence, 0 = rest.
+    window : int, default=10
+        Window length in frames.
+    rest_step : int, default=5
+        Step after an all-rest window.
+    gesture_step : int, default=2
+        Step after a window holding at least one gesture frame.
+
+    Returns
+    -------
+    ndarray of int64 of shape (n_windows,)
+        Start frames, increasing.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._bilstm import sample_windows
+    >>> y = np.r_[np.zeros(20, int), np.ones(10, int), np.zeros(20, int)]
+    >>> sample_windows(y).tolist()
+    [0, 5, 10, 15, 17, 19, 21, 23, 25, 27, 29, 31, 36]
+    """
+    y = np.asarray(y)
+    n = len(y)
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    if n < window:
+        return np.zeros(1, dtype=np.int64)
+    gesture = np.concatenate(([0], np.cumsum(y != 0)))
+    starts, t = [], 0
+    while t + window <= n:
+        starts.append(t)
+        t += gesture_step if gesture[t + window] > gesture[t] else rest_step
+    return np.asarray(starts, dtype=np.int64)
+
+
+def _training_windows(X, y, window, rest_step, gesture_step):
+    """Stacked windows, their per-frame targets and the sequence of each window.
+
+    A sequence shorter than ``window`` gives one window padded on the right with
+    zero frames whose targets are ``IGNORE_INDEX`` (MATLAB pads with 0 on the
+    right, METHOD_SPEC §7.3; the loss skips the padding).
+    """
+    n_features = X[0].shape[1]
+    Xw, yw, seq = [], [], []
+    for i, (x, lab) in enumerate(zip(X, y)):
+        starts = sample_windows(lab, window, rest_step, gesture_step)
+        if len(x) < window:
+            xs = np.zeros((1, window, n_features), dtype=np.float32)
+            ys = np.full((1, window), IGNORE_INDEX, dtype=np.int64)
+            xs[0, : len(x)] = x
+            ys[0, : len(x)] = lab
+        else:
+            idx = starts[:, None] + np.arange(window)
+            xs, ys = x[idx].astype(np.float32), lab[idx].astype(np.int64)
+        Xw.append(xs)
+        yw.append(ys)
+        seq.append(np.full(len(xs), i, dtype=np.int64))
+    return np.concatenate(Xw), np.concatenate(yw), np.concatenate(seq)
+
+
+def _chunks(n_frames, window, overlap):
+    """``(start, end)`` of the inference chunks of a sequence (METHOD_SPEC §7.4).
+
+    Without overlap: consecutive non-overlapping chunks, the last one shorter.
+    With overlap: full windows every ``window // 2`` frames plus one ending at
+    the last frame, so that every frame is covered (one chunk if the sequence
+    is shorter than a window).
+    """
+    if not overlap or n_frames <= window:
+        starts = np.arange(0, n_frames, window)
+        return [(int(s), int(min(s + window, n_frames))) for s in starts]
+    step = max(window // 2, 1)
+    starts = list(range(0, n_frames - window + 1, step))
+    if starts[-1] != n_frames - window:
+        starts.append(n_frames - window)
+    return [(s, s + window) for s in starts]
+
+
+def _predict_chunks(module, X, window, overlap, n_classes):
+    """Per-frame softmax probabilities of ``module`` on chunks of every sequence.
+
+    Each chunk is run with a fresh LSTM state; chunks of equal length are batched
+    together. Frames covered by several chunks (``overlap=True``) average them.
+    """
+    module.eval()
+    device = next(module.parameters()).device
+    groups = {}
+    for i, x in enumerate(X):
+        for s, e in _chunks(len(x), window, overlap):
+            groups.setdefault(e - s, []).append((i, s, e))
+    sums = [np.zeros((len(x), n_classes)) for x in X]
+    counts = [np.zeros((len(x), 1)) for x in X]
+    with torch.inference_mode():
+        for length, items in groups.items():
+            for b in range(0, len(items), PREDICT_BATCH):
+                batch = items[b : b + PREDICT_BATCH]
+                xb = np.stack([X[i][s:e] for i, s, e in batch]).astype(np.float32)
+                logits = module(torch.as_tensor(xb, device=device))
+                prob = torch.softmax(logits, dim=-1).cpu().numpy().astype(np.float64)
+                for (i, s, e), p in zip(batch, prob):
+                    sums[i][s:e] += p
+                    counts[i][s:e] += 1
+    return [s / c for s, c in zip(sums, counts)]
+
+
+class _BiLSTMModule(nn.Module):
+    """Stacked BiLSTMs, LeakyReLU + dropout between them, linear read-out per step.
+
+    Returns the logits of shape ``(batch, n_steps, n_outputs)``. Initialisation
+    follows MATLAB's defaults (METHOD_SPEC §7.2): Glorot-uniform input and
+    read-out weights, orthogonal recurrent weights, forget-gate bias 1, other
+    biases 0.
+    """
+
+    def __init__(self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES,
+                 dropout=CPU_DROPOUT):
+        super().__init__()
+        self.lstms = nn.ModuleList()
+        width = n_inputs
+        for size in hidden_sizes:
+            self.lstms.append(nn.LSTM(width, size, batch_first=True, bidirectional=True))
+            width = 2 * size
+        self.activation = nn.LeakyReLU(LEAKY_SLOPE)
+        self.dropout = nn.Dropout(dropout)
+        self.head = nn.Linear(width, n_outputs)
+        self.reset_parameters()
+
+    def reset_parameters(self):
+        for lstm in self.lstms:
+            size = lstm.hidden_size
+            for name, param in lstm.named_parameters():
+                if name.startswith("weight_ih"):
+                    nn.init.xavier_uniform_(param)
+                elif name.startswith("weight_hh"):
+                    nn.init.orthogonal_(param)
+                elif name.startswith("bias_ih"):
+                    nn.init.zeros_(param)
+                    with torch.no_grad():
+                        param[size : 2 * size] = 1.0  # torch gate order i, f, g, o
+                else:  # bias_hh: the two biases add up
+                    nn.init.zeros_(param)
+        nn.init.xavier_uniform_(self.head.weight)
+        nn.init.zeros_(self.head.bias)
+
+    def forward(self, X):
+        out = X
+        for k, lstm in enumerate(self.lstms):
+            out, _ = lstm(out)
+            if k < len(self.lstms) - 1:
+                out = self.dropout(self.activation(out))
+        return self.head(out)
+
+
+class _StepCrossEntropy(nn.Module):
+    """Cross-entropy of every time step of ``(batch, n_steps, n_classes)`` logits.
+
+    ``time_reduction="sum"`` sums over the steps of a window and averages over
+    the windows of the batch (MATLAB's sequence loss, METHOD_SPEC §7.2);
+    ``"mean"`` averages over every step. Steps whose target is ``IGNORE_INDEX``
+    (padding) are skipped.
+    """
+
+    def __init__(self, time_reduction="sum"):
+        super().__init__()
+        self.time_reduction = time_reduction
+
+    def forward(self, logits, target):
+        flat = logits.reshape(-1, logits.shape[-1])
+        loss = F.cross_entropy(flat, target.reshape(-1), ignore_index=IGNORE_INDEX,
+                               reduction="sum")
+        if self.time_reduction == "sum":
+            return loss / target.shape[0]
+        return loss / (target != IGNORE_INDEX).sum().clamp(min=1)
+
+
+class _SequenceHoldout:
+    """skorch ``train_split`` holding out whole sequences for validation.
+
+    Windows overlap by up to 8 of their 10 frames, so a random split of windows
+    would validate on frames seen in training; whole sequences are held out.
+    """
+
+    def __init__(self, fraction, sequence_ids, random_state):
+        self.fraction = fraction
+        self.sequence_ids = sequence_ids
+        self.random_state = random_state
+
+    def __call__(self, dataset, y=None, **kwargs):
+        ids = np.unique(self.sequence_ids)
+        rng = np.random.RandomState(self.random_state)
+        n_valid = min(max(int(round(self.fraction * len(ids))), 1), len(ids) - 1)
+        held = rng.choice(ids, n_valid, replace=False)
+        valid = np.isin(self.sequence_ids, held)
+        return (
+            torch.utils.data.Subset(dataset, np.flatnonzero(~valid)),
+            torch.utils.data.Subset(dataset, np.flatnonzero(valid)),
+        )
+
+
+class _BiLSTMNet(BaseEstimator):
+    """The trainable part of :class:`BiLSTMTagger`, cached by ``fit_cached``.
+
+    Its parameters are the network and training parameters only, so decision
+    parameters of the tagger never change the cache key. ``fit`` takes the
+    validated sequences and the labels encoded as class indices, and sets
+    ``net_`` (the trained skorch ``NeuralNet``) and ``n_windows_``.
+    """
+
+    def __init__(
+        self,
+        *,
+        n_classes=2,
+        hidden_sizes=CPU_HIDDEN_SIZES,
+        dropout=CPU_DROPOUT,
+        window=WINDOW,
+        rest_step=REST_STEP,
+        gesture_step=GESTURE_STEP,
+        max_epochs=CPU_MAX_EPOCHS,
+        batch_size=BATCH_SIZE,
+        learning_rate=LEARNING_RATE,
+        momentum=MOMENTUM,
+        weight_decay=WEIGHT_DECAY,
+        lr_drop_factor=LR_DROP_FACTOR,
+        lr_drop_period=LR_DROP_PERIOD,
+        time_reduction="sum",
+        early_stopping=False,
+        validation_fraction=VALIDATION_FRACTION,
+        n_iter_no_change=N_ITER_NO_CHANGE,
+        device="cpu",
+        random_state=None,
+        verbose=0,
+    ):
+        self.n_classes = n_classes
+        self.hidden_sizes = hidden_sizes
+        self.dropout = dropout
+        self.window = window
+        self.rest_step = rest_step
+        self.gesture_step = gesture_step
+        self.max_epochs = max_epochs
+        self.batch_size = batch_size
+        self.learning_rate = learning_rate
+        self.momentum = momentum
+        self.weight_decay = weight_decay
+        self.lr_drop_factor = lr_drop_factor
+        self.lr_drop_period = lr_drop_period
+        self.time_reduction = time_reduction
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.device = device
+        self.random_state = random_state
+        self.verbose = verbose
+
+    def fit(self, X, y):
+        Xw, yw, seq = _training_windows(
+            X, y, self.window, self.rest_step, self.gesture_step
+        )
+        seed = seed_from(self.random_state)
+        callbacks = [
+            ("lr_scheduler", LRScheduler(
+                policy=torch.optim.lr_scheduler.StepLR,
+                step_size=self.lr_drop_period, gamma=self.lr_drop_factor,
+            )),
+        ]
+        train_split = None
+        if self.early_stopping:
+            if len(X) < 2:
+                raise ValueError(
+                    "early_stopping holds out whole sequences for validation and "
+                    f"needs at least 2 training sequences, got {len(X)}"
+                )
+            train_split = _SequenceHoldout(self.validation_fraction, seq, seed)
+            callbacks.append(("early_stopping", EarlyStopping(
+                monitor="valid_loss", patience=self.n_iter_no_change,
+                load_best=True, sink=print if self.verbose else _silent,
+            )))
+        self.net_ = NeuralNet(
+            _BiLSTMModule,
+            module__n_inputs=Xw.shape[2],
+            module__n_outputs=self.n_classes,
+            module__hidden_sizes=tuple(self.hidden_sizes),
+            module__dropout=self.dropout,
+            criterion=_StepCrossEntropy,
+            criterion__time_reduction=self.time_reduction,
+            optimizer=torch.optim.SGD,
+            optimizer__momentum=self.momentum,
+            optimizer__weight_decay=self.weight_decay,
+            # L2 on weights only: MATLAB's bias L2 factor is 0 (METHOD_SPEC §7.3)
+            optimizer__param_groups=[("*bias*", {"weight_decay": 0.0})],
+            lr=self.learning_rate,
+            max_epochs=self.max_epochs,
+            batch_size=self.batch_size,
+            iterator_train__shuffle=True,
+            train_split=train_split,
+            callbacks=callbacks,
+            device=self.device,
+            verbose=int(self.verbose > 0),
+        )
+        on_gpu = str(self.device).startswith("cuda")
+        with torch.random.fork_rng(devices=None if on_gpu else []):
+            torch.manual_seed(seed)  # initialisation, dropout and window shuffling
+            self.net_.fit(Xw, yw)
+        self.n_windows_ = len(Xw)
+        return self
+
+
+def _silent(*args, **kwargs):
+    """A skorch ``sink`` that prints nothing."""
+
+
+class BiLSTMTagger(ClassifierMixin, BaseEstimator):
+    """Bidirectional LSTM labelling every frame of a stream (Method C).
+
+    Segments and names gestures in one pass, without a segmentation stage
+    (METHOD_SPEC §7). Training cuts every sequence into windows of ``window``
+    frames (the next window starts ``rest_step`` frames later after an all-rest
+    window, ``gesture_step`` otherwise) and trains stacked bidirectional LSTMs,
+    each but the last followed by LeakyReLU(0.01) and dropout, with a linear
+    read-out and cross-entropy at every time step. The optimiser is SGD with
+    momentum, L2 on the weights and a learning rate dropped by
+    ``lr_drop_factor`` every ``lr_drop_period`` epochs.
+
+    Prediction runs consecutive ``window``-frame chunks of each sequence with a
+    fresh state, smooths every class probability track with MATLAB-style loess,
+    takes the arg-max per frame and sets gesture runs shorter than ``min_run``
+    frames to rest. Only the network depends on the training: ``smooth_span``,
+    ``min_run`` and ``overlap`` can be changed after ``fit``, and with ``memory``
+    a search over them trains once per fold.
+
+    The default network is sized for a small CPU; :meth:`paper` gives the
+    paper's network (1024-1024-512 units, dropout 0.6, 150 epochs), meant for
+    ``device="cuda"``.
+
+    Parameters
+    ----------
+    hidden_sizes : tuple of int, default=(64, 64)
+        Units per direction of each BiLSTM, input side first.
+    dropout : float, default=0.3
+        Drop probability after every BiLSTM but the last.
+    window : int, default=10
+        Length of the training windows and of the inference chunks, in frames.
+    rest_step : int, default=5
+        Start of the next training window after an all-rest window.
+    gesture_step : int, default=2
+        Start of the next training window after one holding a gesture frame.
+    max_epochs : int, default=40
+        Training epochs (the paper: 150).
+    batch_size : int, default=128
+        Windows per mini-batch.
+    learning_rate : float, default=0.01
+        Initial SGD learning rate.
+    momentum : float, default=0.9
+        SGD momentum.
+    weight_decay : float, default=1e-4
+        L2 penalty on the weights (not on the biases).
+    lr_drop_factor : float, default=0.85
+        Factor applied to the learning rate every ``lr_drop_period`` epochs.
+    lr_drop_period : int, default=10
+        Epochs between two learning-rate drops.
+    time_reduction : {"sum", "mean"}, default="sum"
+        Loss of a mini-batch: cross-entropy summed over the time steps of each
+        window and averaged over windows (MATLAB), or averaged over all steps
+        (10 times smaller with 10-frame windows).
+    early_stopping : bool, default=False
+        Hold out ``validation_fraction`` of the training sequences, stop after
+        ``n_iter_no_change`` epochs without a lower validation loss, and keep
+        the weights of the best epoch.
+    validation_fraction : float, default=0.1
+        Share of the sequences held out when ``early_stopping`` is on.
+    n_iter_no_change : int, default=10
+        Patience of the early stopping, in epochs.
+    smooth_span : int or float, default=15
+        Loess span of the probability smoothing, in frames (a float below 1 is
+        a fraction of the sequence; 5 leaves interior frames unchanged).
+    min_run : int, default=15
+        Shortest gesture run kept, in frames; shorter runs become rest.
+    overlap : bool, default=False
+        Predict over windows overlapping by half (step ``window // 2``) and
+        average the frames' probabilities, instead of non-overlapping chunks.
+    memory : None, str or joblib.Memory, default=None
+        Caches the trained network keyed on the training data and the network
+        and training parameters only.
+    device : str, default="cpu"
+        Torch device of the training (``"cuda"`` for :meth:`paper`). A fitted
+        tagger loads and predicts on a machine without CUDA.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the initialisation, the dropout, the window shuffling and the
+        validation split.
+    verbose : int, default=0
+        0 is silent; 1 or more prints one line per epoch.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        Labels seen in ``fit``, rest (0) first.
+    net_ : skorch.NeuralNet
+        The trained network; ``net_.history`` holds the losses and learning
+        rates (``"event_lr"``) of every epoch.
+    n_windows_ : int
+        Number of training windows.
+    n_features_in_ : int
+        Number of features per frame.
+    frame_shape_in_ : tuple of int
+        Shape of one input frame, ``(n_features_in_,)``.
+
+    See Also
+    --------
+    PoseDescriptor : Gives the per-frame features.
+    MultiScaleClassifier : Methods A and B, on periods of activity.
+
+    Notes
+    -----
+    The rules follow METHOD_SPEC §7: windows §7.1, network §7.2, optimiser
+    §7.3, inference §7.4 (per-frame output, last chunk shorter: decision D18),
+    smoothing span decision D12. Differences from MATLAB: torch's SGD keeps
+    its momentum buffer in gradient units, so after a learning-rate drop the
+    old velocity shrinks with the rate; windows are reshuffled every epoch
+    (MATLAB shuffles once).
+
+    A training sequence shorter than ``window`` gives one window padded with
+    zero frames on the right, the padding being left out of the loss (MATLAB
+    pads on the right too); prediction takes sequences of any length >= 1.
+
+    Cost of the CPU default: fitting on the 48 PRECOG sequences (12,269 frames,
+    9 classes, 183-D descriptors, 4,1xx windows) takes about XX s on 2 CPU
+    cores (torch 2.13), measured with::
+
+        python -c "import time; from skgesture import make_method_c; \\
+        from skgesture.datasets import load_precog; d = load_precog(); \\
+        t = time.time(); make_method_c(random_state=0).fit(d.X, d.y); \\
+        print(time.time() - t)"
+
+    References
+    ----------
+    .. [1] Brás, Simão & Neto, "Gesture Recognition from Skeleton Data for
+       Intuitive Human-Machine Interaction".
+
+    Examples
+    --------
+    >>> from skgesture import BiLSTMTagger, PoseDescriptor
+    >>> from skgesture.utils._testing import make_skeleton_stream
+    >>> X, y = make_skeleton_stream(random_state=0)
+    >>> D = PoseDescriptor().fit_transform([X])
+    >>> tagger = BiLSTMTagger(hidden_sizes=(16,), max_epochs=20, random_state=0)
+    >>> tagger = tagger.fit(D, [y])
+    >>> tagger.classes_.tolist()
+    [0, 1, 2, 3]
+    >>> proba = tagger.predict_proba(D)[0]
+    >>> proba.shape == (len(X), 4), bool(abs(proba.sum(axis=1) - 1).max() < 1e-6)
+    (True, True)
+    >>> tagger.predict(D)[0].shape == y.shape
+    True
+    """
+
+    _parameter_constraints: dict = {
+        "hidden_sizes": [tuple, list],
+        "dropout": [Interval(Real, 0, 1, closed="left")],
+        "window": [Interval(Integral, 1, None, closed="left")],
+        "rest_step": [Interval(Integral, 1, None, closed="left")],
+        "gesture_step": [Interval(Integral, 1, None, closed="left")],
+        "max_epochs": [Interval(Integral, 1, None, closed="left")],
+        "batch_size": [Interval(Integral, 1, None, closed="left")],
+        "learning_rate": [Interval(Real, 0, None, closed="neither")],
+        "momentum": [Interval(Real, 0, 1, closed="left")],
+        "weight_decay": [Interval(Real, 0, None, closed="left")],
+        "lr_drop_factor": [Interval(Real, 0, 1, closed="right")],
+        "lr_drop_period": [Interval(Integral, 1, None, closed="left")],
+        "time_reduction": [StrOptions({"sum", "mean"})],
+        "early_stopping": ["boolean"],
+        "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
+        "n_iter_no_change": [Interval(Integral, 1, None, closed="left")],
+        "smooth_span": [Interval(Real, 0, None, closed="neither")],
+        "min_run": [Interval(Integral, 1, None, closed="left")],
+        "overlap": ["boolean"],
+        "memory": [None, str, HasMethods(["cache"])],
+        "device": [str],
+        "random_state": ["random_state"],
+        "verbose": ["verbose"],
+    }
+
+    def __init__(
+        self,
+        *,
+        hidden_sizes=CPU_HIDDEN_SIZES,
+        dropout=CPU_DROPOUT,
+        window=WINDOW,
+        rest_step=REST_STEP,
+        gesture_step=GESTURE_STEP,
+        max_epochs=CPU_MAX_EPOCHS,
+        batch_size=BATCH_SIZE,
+        learning_rate=LEARNING_RATE,
+        momentum=MOMENTUM,
+        weight_decay=WEIGHT_DECAY,
+        lr_drop_factor=LR_DROP_FACTOR,
+        lr_drop_period=LR_DROP_PERIOD,
+        time_reduction="sum",
+        early_stopping=False,
+        validation_fraction=VALIDATION_FRACTION,
+        n_iter_no_change=N_ITER_NO_CHANGE,
+        smooth_span=SMOOTH_SPAN,
+        min_run=MIN_RUN,
+        overlap=False,
+        memory=None,
+        device="cpu",
+        random_state=None,
+        verbose=0,
+    ):
+        self.hidden_sizes = hidden_sizes
+        self.dropout = dropout
+        self.window = window
+        self.rest_step = rest_step
+        self.gesture_step = gesture_step
+        self.max_epochs = max_epochs
+        self.batch_size = batch_size
+        self.learning_rate = learning_rate
+        self.momentum = momentum
+        self.weight_decay = weight_decay
+        self.lr_drop_factor = lr_drop_factor
+        self.lr_drop_period = lr_drop_period
+        self.time_reduction = time_reduction
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.smooth_span = smooth_span
+        self.min_run = min_run
+        self.overlap = overlap
+        self.memory = memory
+        self.device = device
+        self.random_state = random_state
+        self.verbose = verbose
+
+    @classmethod
+    def paper(cls, **overrides):
+        """The paper's network: BiLSTM 1024-1024-512, dropout 0.6, 150 epochs.
+
+        Parameters
+        ----------
+        **overrides
+            Any other constructor parameter, e.g. ``device="cuda"``, which this
+            size needs in practice (the default device stays ``"cpu"``).
+
+        Returns
+        -------
+        BiLSTMTagger
+            The unfitted tagger.
+
+        Examples
+        --------
+        >>> from skgesture import BiLSTMTagger
+        >>> BiLSTMTagger.paper(device="cuda").hidden_sizes
+        (1024, 1024, 512)
+        """
+        params = {
+            "hidden_sizes": PAPER_HIDDEN_SIZES,
+            "dropout": PAPER_DROPOUT,
+            "max_epochs": PAPER_MAX_EPOCHS,
+        }
+        params.update(overrides)
+        return cls(**params)
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y):
+        """Train the network on windows of every sequence.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features (e.g. from :class:`PoseDescriptor`).
+        y : list of ndarray of shape (n_frames_i,)
+            Per-frame labels, 0 = rest, 1..K gesture classes; both rest and
+            gesture frames must occur.
+
+        Returns
+        -------
+        self : BiLSTMTagger
+            The fitted tagger.
+        """
+        hidden = self.hidden_sizes
+        if len(hidden) == 0 or not all(
+            isinstance(h, Integral) and not isinstance(h, bool) and h >= 1
+            for h in hidden
+        ):
+            raise ValueError(
+                f"hidden_sizes must be a non-empty tuple of positive ints, got {hidden!r}"
+            )
+        X = check_sequences(X, ndim=2, estimator=self, reset=True)
+        y = check_sequence_labels(y, X)
+        classes, y_idx = np.unique(np.concatenate(y), return_inverse=True)
+        if classes[0] != 0:
+            raise ValueError(
+                "y has no rest frame (label 0): the tagger learns gestures against "
+                f"rest, got labels {classes.tolist()}"
+            )
+        if len(classes) < 2:
+            raise ValueError(
+                "y has no gesture frame (every label is 0): the tagger needs "
+                "labels 1..K as well as rest"
+            )
+        y_idx = np.split(y_idx.astype(np.int64), np.cumsum([len(v) for v in y])[:-1])
+        random_state = (
+            None if self.random_state is None else seed_from(self.random_state)
+        )
+        network = _BiLSTMNet(
+            n_classes=len(classes),
+            hidden_sizes=tuple(int(h) for h in hidden),
+            dropout=self.dropout,
+            window=self.window,
+            rest_step=self.rest_step,
+            gesture_step=self.gesture_step,
+            max_epochs=self.max_epochs,
+            batch_size=self.batch_size,
+            learning_rate=self.learning_rate,
+            momentum=self.momentum,
+            weight_decay=self.weight_decay,
+            lr_drop_factor=self.lr_drop_factor,
+            lr_drop_period=self.lr_drop_period,
+            time_reduction=self.time_reduction,
+            early_stopping=self.early_stopping,
+            validation_fraction=self.validation_fraction,
+            n_iter_no_change=self.n_iter_no_change,
+            device=self.device,
+            random_state=random_state,
+            verbose=self.verbose,
+        )
+        fitted = fit_cached(self.memory, network, X, y_idx)
+        self.classes_ = classes
+        self.net_ = fitted.net_
+        self.n_windows_ = fitted.n_windows_
+        return self
+
+    def predict_proba(self, X):
+        """Raw per-frame class probabilities (before smoothing).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features; any length >= 1.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i, n_classes)
+            Rows sum to 1; columns in ``classes_`` order.
+        """
+        check_is_fitted(self)
+        X = check_sequences(X, ndim=2, estimator=self, reset=False)
+        return _predict_chunks(
+            self.net_.module_, X, self.window, self.overlap, len(self.classes_)
+        )
+
+    def decision_function(self, X):
+        """Loess-smoothed per-frame class probabilities.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i, n_classes)
+            Every class track smoothed with span ``smooth_span``; the arg-max
+            of a row is the frame's label before the ``min_run`` filter.
+        """
+        return [
+            np.asarray(loess_smooth(p, self.smooth_span, axis=0))
+            for p in self.predict_proba(X)
+        ]
+
+    def predict(self, X):
+        """Per-frame labels.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i,)
+            Labels from ``classes_``; gesture runs shorter than ``min_run`` are
+            rest (0).
+        """
+        return [self._decide(s) for s in self.decision_function(X)]
+
+    def predict_segments(self, X):
+        """Gesture instances with their confidence.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_segments_i, 4)
+            Rows ``(class, start, end, confidence)``, 0-based, ``end``
+            exclusive; the confidence is the mean raw probability of the class
+            over the run.
+        """
+        out = []
+        for p in self.predict_proba(X):
+            labels = self._decide(np.asarray(loess_smooth(p, self.smooth_span, axis=0)))
+            rows = [
+                (c, s, e, float(p[s:e, np.searchsorted(self.classes_, c)].mean()))
+                for c, s, e in labels_to_segments(labels)
+            ]
+            out.append(np.array(rows, dtype=float).reshape(-1, 4))
+        return out
+
+    def score(self, X, y, sample_weight=None):
+        """Mean official ChaLearn 2014 Jaccard index.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+        y : list of ndarray of shape (n_frames_i,)
+            True per-frame labels.
+        sample_weight : None
+            Not supported.
+
+        Returns
+        -------
+        float
+            Mean Jaccard index over the sequences.
+        """
+        from skgesture.metrics import jaccard_index
+
+        return jaccard_index(y, self.predict(X))
+
+    def _decide(self, smoothed):
+        labels = self.classes_[np.argmax(smoothed, axis=1)]
+        return remove_short_runs(labels, self.min_run)
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        tags.non_deterministic = self.device != "cpu"
+        return tags

@@ -1,0 +1,4 @@
+"""Streaming recognition (temporary init)."""
+from skgesture.streaming._recognizer import GestureEvent, StreamingRecognizer
+
+__all__ = ["GestureEvent", "StreamingRecognizer"]
