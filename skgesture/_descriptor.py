@@ -166,11 +166,12 @@ def _body_frame(P, torso, left_right, spine):
     left, right = P[:, left_right[0]], P[:, left_right[1]]
     up = P[:, spine[1]] - P[:, spine[0]]
     s = np.cross(left - right, up)
+    ok_s = _norm(s) > MIN_NORM  # collinear shoulders and spine: no orientation
     sign = np.where(np.einsum("ti,ti->t", n, s) < 0, -1.0, 1.0)
     u_z = n * sign[:, None]
     u_y, ok_y = _unit(up - np.einsum("ti,ti->t", up, u_z)[:, None] * u_z)
     u_x = np.cross(u_y, u_z)
-    ok = ok_n & ok_y
+    ok = ok_n & ok_y & ok_s
     if not ok.all():
         # Degenerate frames reuse the previous frame's basis; camera axes before
         # the first good frame (METHOD_SPEC §3.8).

@@ -149,7 +149,8 @@ def decide_period(scores, centres, length, *, short_length=SHORT_LENGTH,
     rec = np.where(top > threshold_long, best, -1)
     starts, ends, vals = runs(rec)
     owner_dist = np.full(length, np.inf)
-    segments = []
+    owner = np.full(length, -1)
+    kept = []
     for s, e, v in zip(starts, ends, vals):
         if v < 0 or e - s < min_consecutive:
             continue
@@ -158,9 +159,17 @@ def decide_period(scores, centres, length, *, short_length=SHORT_LENGTH,
         frames = np.arange(lo, hi)
         dist = np.abs(frames[:, None] - c[None, :]).min(axis=1)
         win = dist < owner_dist[lo:hi]  # strict: the earlier run keeps ties
-        labels[lo:hi][win] = v + 1
+        owner[lo:hi][win] = len(kept)
         owner_dist[lo:hi][win] = dist[win]
-        segments.append((int(v) + 1, lo, hi, float(top[s:e].mean())))
+        kept.append((int(v) + 1, float(top[s:e].mean())))
+    # Segments are read off the final ownership, so they agree with the labels.
+    segments = []
+    o_starts, o_ends, o_vals = runs(owner)
+    for a, b, r in zip(o_starts, o_ends, o_vals):
+        if r >= 0:
+            cls, conf = kept[r]
+            labels[a:b] = cls
+            segments.append((cls, int(a), int(b), conf))
     return labels, segments
 
 

@@ -22,7 +22,7 @@ def check_steps(steps, n_poses):
     """Validate ``steps`` and ``n_poses``; return ``steps`` as a tuple of ints."""
     try:
         steps = tuple(int(s) for s in steps)
-    except TypeError:
+    except (TypeError, ValueError):
         raise ValueError(f"steps must be a sequence of positive ints, got {steps!r}") from None
     if not steps or any(s < 1 for s in steps):
         raise ValueError(f"steps must be a non-empty sequence of positive ints, got {steps!r}")

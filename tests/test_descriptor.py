@@ -513,11 +513,6 @@ def test_body_frame_degenerate_frame_reuses_previous_basis_or_camera_axes():
     assert_allclose(u_z[2], u_z[1])
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: _body_frame does not treat s = (SL - SR) x (SC - HC) ~ 0 as "
-    "degenerate (METHOD_SPEC §3.8); a collinear torso gets an arbitrary basis",
-)
 def test_body_frame_collinear_torso_is_degenerate():
     collinear = np.zeros((11, 3))
     collinear[:, 1] = np.linspace(0.0, 1.0, 11)  # every joint on the y axis: s = 0

@@ -181,11 +181,6 @@ def test_decide_long_period_exact_tie_goes_to_the_earlier_run():
     assert_array_equal(labels, expected)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: decide_period returns each run's full extent, so segments of "
-    "overlapping runs overlap and disagree with the per-frame labels",
-)
 def test_decide_long_period_segments_agree_with_labels():
     labels, segments = decide_period(_long_scores({**RUN_A, **RUN_B}), LONG_CENTRES,
                                      LONG_L, threshold_long=THRESHOLD_LONG)  # fmt: skip
