@@ -7,7 +7,6 @@ from numbers import Integral, Real
 import numpy as np
 import torch
 from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
-from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 from skorch import NeuralNet
@@ -184,7 +183,9 @@ class _BiLSTMModule(nn.Module):
         self.lstms = nn.ModuleList()
         width = n_inputs
         for size in hidden_sizes:
-            self.lstms.append(nn.LSTM(width, size, batch_first=True, bidirectional=True))
+            self.lstms.append(
+                nn.LSTM(width, size, batch_first=True, bidirectional=True)
+            )
             width = 2 * size
         self.activation = nn.LeakyReLU(LEAKY_SLOPE)
         self.dropout = nn.Dropout(dropout)
@@ -647,7 +648,8 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
             for h in hidden
         ):
             raise ValueError(
-                f"hidden_sizes must be a non-empty tuple of positive ints, got {hidden!r}"
+                "hidden_sizes must be a non-empty tuple of positive ints, got "
+                f"{hidden!r}"
             )
         X = check_sequences(X, ndim=2, estimator=self, reset=True)
         y = check_sequence_labels(y, X)

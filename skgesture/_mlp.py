@@ -5,6 +5,7 @@
 from numbers import Integral, Real
 
 import numpy as np
+import torch
 from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
@@ -167,6 +168,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
                 f"TorchMLPClassifier needs at least 2 classes in y, got {n_classes}"
             )
         binary = n_classes == 2
+        seed = seed_from(self.random_state)
         module_params = {
             "n_inputs": X.shape[1],
             "n_outputs": 1 if binary else n_classes,
@@ -187,11 +189,14 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
             validation_fraction=validation,
             test_fraction=self.test_fraction if validation > 0 else 0.0,
             max_fail=self.max_fail,
-            seed=seed_from(self.random_state),
+            seed=seed,
             device=self.device,
             verbose=self.verbose,
         )
         target = y_idx.astype(np.float32).reshape(-1, 1) if binary else y_idx
+        # skorch does not seed (its FAQ): the initialisation and the shuffling use
+        # torch's global RNG, so seed it from random_state (STYLE.md §5).
+        torch.manual_seed(seed)
         self.net_.fit(X, target)
         return self
 

@@ -198,7 +198,9 @@ def test_step_cross_entropy_sum_is_steps_times_mean():
     assert_allclose(mean, ref.item(), rtol=1e-6)
     assert_allclose(total, 10 * mean, rtol=1e-6)
     target[0, 5:] = IGNORE_INDEX
-    ref = torch.nn.functional.cross_entropy(logits[0, :5], target[0, :5], reduction="sum")
+    ref = torch.nn.functional.cross_entropy(
+        logits[0, :5], target[0, :5], reduction="sum"
+    )
     assert_allclose(
         _StepCrossEntropy("sum")(logits[:1], target[:1]).item(), ref.item(), rtol=1e-6
     )
@@ -391,6 +393,22 @@ def test_early_stopping_validates_on_held_out_sequences(toy):
     assert stopper.load_best and stopper.patience == 3
     with pytest.raises(ValueError, match="at least 2 training sequences"):
         BiLSTMTagger(**TINY, early_stopping=True).fit(X[:1], y[:1])
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="needs a machine without CUDA")
+def test_cuda_tagged_model_loads_on_cpu(fitted, toy_test):
+    # A net saved from a GPU records device="cuda"; skorch maps it to the CPU with a
+    # DeviceWarning when CUDA is unavailable (the real GPU round trip is below).
+    tagger = pickle.loads(pickle.dumps(fitted))
+    tagger.net_.device = "cuda"
+    blob = pickle.dumps(tagger)
+    with pytest.warns(UserWarning) as record:
+        loaded = pickle.loads(blob)
+    assert any("no CUDA devices are available" in str(w.message) for w in record)
+    assert str(loaded.net_.device) == "cpu"
+    X = toy_test[0][:2]
+    for a, b in zip(fitted.predict_proba(X), loaded.predict_proba(X)):
+        assert_array_equal(a, b)
 
 
 @pytest.mark.gpu

@@ -72,11 +72,17 @@ ATOL_4DP = 5e-5
 ATOL_6DP = 5e-7
 
 # §3.9-§3.11 worked examples.
-INCLINATION_EXAMPLE = {"HipCenter": (0, 0, 0), "ShoulderCenter": (0, 1, 0),
-                       "Head": (0.5, 1.5, 0)}  # fmt: skip
+INCLINATION_EXAMPLE = {
+    "HipCenter": (0, 0, 0),
+    "ShoulderCenter": (0, 1, 0),
+    "Head": (0.5, 1.5, 0),
+}
 INCLINATION_GT = 3 * np.pi / 4  # 2.356194
-AZIMUTH_EXAMPLE = {"HipCenter": (0, 0, 0), "ShoulderCenter": (0, 1, 0),
-                   "Head": (0.5, 1.5, 0.5)}  # fmt: skip
+AZIMUTH_EXAMPLE = {
+    "HipCenter": (0, 0, 0),
+    "ShoulderCenter": (0, 1, 0),
+    "Head": (0.5, 1.5, 0.5),
+}
 AZIMUTH_GT = np.pi / 4  # 0.785398, with u_x = (1, 0, 0)
 BENDING_POINT = (0.0, 0.3, 0.3)
 BENDING_GT = np.pi / 4  # 0.785398, with u_z = (0, 0, 1)
@@ -145,8 +151,10 @@ def _reference_body_frame(P):
     for frame in P:
         pts = frame[torso] - frame[torso].mean(axis=0)
         n = np.linalg.svd(pts)[2][-1]
-        s = np.cross(frame[_j("ShoulderLeft")] - frame[_j("ShoulderRight")],
-                     frame[_j("ShoulderCenter")] - frame[_j("HipCenter")])
+        s = np.cross(
+            frame[_j("ShoulderLeft")] - frame[_j("ShoulderRight")],
+            frame[_j("ShoulderCenter")] - frame[_j("HipCenter")],
+        )
         z = n * np.sign(n @ s)
         up = frame[_j("ShoulderCenter")] - frame[_j("HipCenter")]
         y = up - (up @ z) * z
@@ -175,8 +183,9 @@ def _reference_angles(P):
             row_a.append(_angle(b2 - (b2 @ b1) * b1, x_axis - (x_axis @ b1) * b1))
         incl.append(row_i)
         azim.append(row_a)
-        bend.append([0.0 if np.linalg.norm(p) < 1e-8 else _angle(p, z_axis)
-                     for p in frame])  # fmt: skip
+        bend.append(
+            [0.0 if np.linalg.norm(p) < 1e-8 else _angle(p, z_axis) for p in frame]
+        )
     return np.array(incl), np.array(azim), np.array(bend)
 
 
@@ -205,8 +214,12 @@ def test_descriptor_has_183_features_in_the_layout_of_spec_3_13(raw_descriptor):
     assert len(names) == N_FEATURES_PAPER11
     for start, stop, prefix in LAYOUT_GT:
         assert all(n.startswith(prefix) for n in names[start:stop]), prefix
-    expected = [f"{kind}_{j}_{c}" for kind in ("pos", "vel", "acc")
-                for j in JOINTS_GT for c in "xyz"]  # fmt: skip
+    expected = [
+        f"{kind}_{j}_{c}"
+        for kind in ("pos", "vel", "acc")
+        for j in JOINTS_GT
+        for c in "xyz"
+    ]
     expected += [f"incl_{'_'.join(t)}" for t in TRIPLES_GT]
     expected += [f"azim_{'_'.join(t)}" for t in TRIPLES_GT]
     expected += [f"bend_{j}" for j in JOINTS_GT]
@@ -241,9 +254,17 @@ def test_descriptor_full20_has_426_features(stream):
     assert len(desc.get_feature_names_out()) == N_FEATURES_FULL20
     assert np.isfinite(Z).all()
     # 20 joints in Kinect order: the first position block is HipCenter, then Spine
-    assert_array_equal(desc.get_feature_names_out()[:6],
-                       ["pos_HipCenter_x", "pos_HipCenter_y", "pos_HipCenter_z",
-                        "pos_Spine_x", "pos_Spine_y", "pos_Spine_z"])  # fmt: skip
+    assert_array_equal(
+        desc.get_feature_names_out()[:6],
+        [
+            "pos_HipCenter_x",
+            "pos_HipCenter_y",
+            "pos_HipCenter_z",
+            "pos_Spine_x",
+            "pos_Spine_y",
+            "pos_Spine_z",
+        ],
+    )
 
 
 def test_descriptor_accepts_a_custom_joint_set(stream):
@@ -266,8 +287,9 @@ def test_descriptor_is_invariant_to_translating_the_whole_skeleton(stream, kind)
         shift = np.hstack([np.sin(t), 0.1 * t, -0.05 * t])[:, None, :]
     shifted = stream + shift
     desc = PoseDescriptor().fit([stream])
-    assert_allclose(desc.transform([shifted])[0], desc.transform([stream])[0],
-                    atol=1e-9)  # fmt: skip
+    assert_allclose(
+        desc.transform([shifted])[0], desc.transform([stream])[0], atol=1e-9
+    )
     refit = PoseDescriptor().fit([shifted])
     assert_allclose(refit.link_lengths_, desc.link_lengths_, rtol=1e-12)
     assert_allclose(refit.mean_, desc.mean_, atol=1e-9)
@@ -344,8 +366,9 @@ def test_smooth_time_smooths_every_column_of_a_3d_array_alike():
 
 def test_descriptor_border_parameter_is_used(stream):
     keep = [KINECT_V1.index(j) for j in JOINTS_GT]
-    Z = PoseDescriptor(border="zero", link_normalisation=False,
-                       standardize=False).fit_transform([stream])[0]  # fmt: skip
+    Z = PoseDescriptor(
+        border="zero", link_normalisation=False, standardize=False
+    ).fit_transform([stream])[0]
     # zero padding pulls the first frame towards the root by the two missing taps
     P0 = (stream[0, keep] - stream[0, 0]).ravel()
     P1 = (stream[1, keep] - stream[1, 0]).ravel()
@@ -399,17 +422,20 @@ def test_link_normalise_simao_direction_points_from_normalised_parent():
     p = _link_normalise(q, links, np.full(len(links), 0.3), "simao")
     for a, b in links:
         d = q[:, b] - p[:, a]
-        assert_allclose(p[:, b] - p[:, a],
-                        0.3 * d / np.linalg.norm(d, axis=1, keepdims=True),
-                        atol=1e-12)  # fmt: skip
+        assert_allclose(
+            p[:, b] - p[:, a],
+            0.3 * d / np.linalg.norm(d, axis=1, keepdims=True),
+            atol=1e-12,
+        )
 
 
 def test_link_normalise_zero_length_link_puts_child_on_parent():
     q = _pose()[None].copy()
     q[0, KINECT_V1.index("WristLeft")] = q[0, KINECT_V1.index("ElbowLeft")]
     p = _link_normalise(q, _link_indices(), np.full(13, 0.25), "original")
-    assert_allclose(p[0, KINECT_V1.index("WristLeft")],
-                    p[0, KINECT_V1.index("ElbowLeft")])  # fmt: skip
+    assert_allclose(
+        p[0, KINECT_V1.index("WristLeft")], p[0, KINECT_V1.index("ElbowLeft")]
+    )
     assert np.isfinite(p).all()
 
 
@@ -546,8 +572,12 @@ def test_distances_match_brute_force():
 def test_descriptor_distances_are_those_of_the_smoothed_positions(raw_descriptor):
     _, Z = raw_descriptor
     P = Z[:, :33].reshape(-1, 11, 3)
-    ref = np.array([[np.linalg.norm(f[a] - f[b])
-                     for a, b in combinations(range(11), 2)] for f in P])  # fmt: skip
+    ref = np.array(
+        [
+            [np.linalg.norm(f[a] - f[b]) for a, b in combinations(range(11), 2)]
+            for f in P
+        ]
+    )
     assert_allclose(Z[:, DIST:], ref, atol=1e-9)
 
 
@@ -653,7 +683,10 @@ def test_descriptor_on_real_montalbano_sample(shared_data):
     "bad, message",
     [
         (np.ones((5, 60)), r"X\[1\] has shape \(5, 60\); expected \(n_frames, 20, 3\)"),
-        (np.ones((5, 19, 3)), r"X\[1\] has frames of shape \(19, 3\); expected \(20, 3\)"),
+        (
+            np.ones((5, 19, 3)),
+            r"X\[1\] has frames of shape \(19, 3\); expected \(20, 3\)",
+        ),
         (np.ones((0, 20, 3)), r"X\[1\] has 0 frames"),
         (np.full((5, 20, 3), np.inf), r"X\[1\] contains infinite values"),
     ],

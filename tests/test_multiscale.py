@@ -58,9 +58,13 @@ SHORT_CASES = {
     "tie_is_rest": ([(0, 0.95), (0, 0.90), (1, 0.88), (1, 0.93)], 0),
     "half_is_not_a_majority": ([(0, 0.95), (0, 0.90), (1, 0.88), (2, 0.93)], 0),
     "plurality_is_not_a_majority": (
-        [(0, 0.95), (0, 0.9), (0, 0.9), (1, 0.9), (1, 0.9), (2, 0.9), (2, 0.9)], 0),
+        [(0, 0.95), (0, 0.9), (0, 0.9), (1, 0.9), (1, 0.9), (2, 0.9), (2, 0.9)],
+        0,
+    ),
     "votes_below_threshold_ignored": (
-        [(2, 0.95), (1, 0.80), (1, 0.80), (1, 0.80), (1, 0.87)], 3),
+        [(2, 0.95), (1, 0.80), (1, 0.80), (1, 0.80), (1, 0.87)],
+        3,
+    ),
     "no_votes_is_rest": ([(0, 0.80), (1, 0.70), (2, 0.60)], 0),
 }
 SHORT_CONF_GT = (0.95 + 0.90 + 0.92) / 3  # "absolute_majority": mean top of its votes
@@ -79,16 +83,18 @@ OVERLAP_LABELS_GT[20:29] = 2
 def test_decide_short_period(case):
     tops, expected = SHORT_CASES[case]
     scores = _scores(tops)
-    labels, segments = decide_period(scores, SHORT_CENTRES[: len(scores)], SHORT_L,
-                                     threshold_short=THRESHOLD_SHORT)  # fmt: skip
+    labels, segments = decide_period(
+        scores, SHORT_CENTRES[: len(scores)], SHORT_L, threshold_short=THRESHOLD_SHORT
+    )
     assert_array_equal(labels, np.full(SHORT_L, expected))
     assert len(segments) == (expected > 0)
 
 
 def test_decide_short_period_segment_and_confidence():
     tops, _ = SHORT_CASES["absolute_majority"]
-    _, segments = decide_period(_scores(tops), SHORT_CENTRES, SHORT_L,
-                                threshold_short=THRESHOLD_SHORT)  # fmt: skip
+    _, segments = decide_period(
+        _scores(tops), SHORT_CENTRES, SHORT_L, threshold_short=THRESHOLD_SHORT
+    )
     assert len(segments) == 1
     cls, start, end, conf = segments[0]
     assert (cls, start, end) == (1, 0, SHORT_L)
@@ -97,13 +103,17 @@ def test_decide_short_period_segment_and_confidence():
 
 def test_decide_short_period_lower_threshold_admits_more_votes():
     tops, _ = SHORT_CASES["votes_below_threshold_ignored"]
-    labels, _ = decide_period(_scores(tops), SHORT_CENTRES, SHORT_L, threshold_short=0.7)
+    labels, _ = decide_period(
+        _scores(tops), SHORT_CENTRES, SHORT_L, threshold_short=0.7
+    )
     assert_array_equal(labels, 2)  # now class index 1 has 4 of 5 votes
 
 
 def test_decide_score_equal_to_threshold_does_not_vote():
     scores = _scores([(0, 0.75)] * 5)
-    labels, segments = decide_period(scores, SHORT_CENTRES, SHORT_L, threshold_short=0.75)
+    labels, segments = decide_period(
+        scores, SHORT_CENTRES, SHORT_L, threshold_short=0.75
+    )
     assert_array_equal(labels, 0)
     assert segments == []
 
@@ -115,8 +125,9 @@ def test_decide_without_windows_is_rest():
 
 
 def test_decide_long_period_run_of_3_labels_first_start_to_last_end():
-    labels, segments = decide_period(_long_scores(RUN_A), LONG_CENTRES, LONG_L,
-                                     threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, segments = decide_period(
+        _long_scores(RUN_A), LONG_CENTRES, LONG_L, threshold_long=THRESHOLD_LONG
+    )
     expected = np.zeros(LONG_L, int)
     expected[10:23] = 1  # centres 14..18 -> frames 14-4 .. 18+4
     assert_array_equal(labels, expected)
@@ -126,30 +137,40 @@ def test_decide_long_period_run_of_3_labels_first_start_to_last_end():
 
 
 def test_decide_long_period_two_consecutive_windows_are_not_enough():
-    labels, segments = decide_period(_long_scores({5: (0, 0.9), 6: (0, 0.9)}),
-                                     LONG_CENTRES, LONG_L)  # fmt: skip
+    labels, segments = decide_period(
+        _long_scores({5: (0, 0.9), 6: (0, 0.9)}), LONG_CENTRES, LONG_L
+    )
     assert_array_equal(labels, 0)
     assert segments == []
 
 
 def test_decide_long_period_run_broken_by_a_weak_window_is_not_counted():
     runs = {5: (0, 0.9), 6: (0, 0.9), 7: (0, 0.6), 8: (0, 0.9), 9: (0, 0.9)}
-    labels, _ = decide_period(_long_scores(runs), LONG_CENTRES, LONG_L,
-                              threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, _ = decide_period(
+        _long_scores(runs), LONG_CENTRES, LONG_L, threshold_long=THRESHOLD_LONG
+    )
     assert_array_equal(labels, 0)
 
 
 def test_decide_long_period_uses_the_long_threshold():
-    runs = {k: (2, 0.7) for k in range(5, 9)}
-    labels, _ = decide_period(_long_scores(runs), LONG_CENTRES, LONG_L,
-                              threshold_short=THRESHOLD_SHORT,
-                              threshold_long=THRESHOLD_LONG)  # fmt: skip
+    runs = dict.fromkeys(range(5, 9), (2, 0.7))
+    labels, _ = decide_period(
+        _long_scores(runs),
+        LONG_CENTRES,
+        LONG_L,
+        threshold_short=THRESHOLD_SHORT,
+        threshold_long=THRESHOLD_LONG,
+    )
     assert_array_equal(np.flatnonzero(labels), np.arange(10, 25))
     assert_array_equal(labels[10:25], 3)
     # the same windows in a short period do not reach the short threshold
-    labels, _ = decide_period(_long_scores(runs)[:20], LONG_CENTRES[:20], 54,
-                              threshold_short=THRESHOLD_SHORT,
-                              threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, _ = decide_period(
+        _long_scores(runs)[:20],
+        LONG_CENTRES[:20],
+        54,
+        threshold_short=THRESHOLD_SHORT,
+        threshold_long=THRESHOLD_LONG,
+    )
     assert_array_equal(labels, 0)
 
 
@@ -162,8 +183,12 @@ def test_decide_short_length_boundary(length, is_short):
 
 
 def test_decide_long_period_overlapping_runs_split_by_nearest_centre():
-    labels, segments = decide_period(_long_scores({**RUN_A, **RUN_B}), LONG_CENTRES,
-                                     LONG_L, threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, segments = decide_period(
+        _long_scores({**RUN_A, **RUN_B}),
+        LONG_CENTRES,
+        LONG_L,
+        threshold_long=THRESHOLD_LONG,
+    )
     # frame 19 is 1 frame from centre 18 (A) and from centre 20 (B): earlier run A
     assert_array_equal(labels, OVERLAP_LABELS_GT)
     assert [s[0] for s in segments] == [1, 2]
@@ -173,8 +198,9 @@ def test_decide_long_period_overlapping_runs_split_by_nearest_centre():
 def test_decide_long_period_exact_tie_goes_to_the_earlier_run():
     # A at centres 14-18, B at centres 22-26 (window 9 weak): frame 20 is 2 from both
     runs = {**RUN_A, 9: (1, 0.8), 10: (1, 0.8), 11: (1, 0.8)}
-    labels, _ = decide_period(_long_scores(runs), LONG_CENTRES, LONG_L,
-                              threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, _ = decide_period(
+        _long_scores(runs), LONG_CENTRES, LONG_L, threshold_long=THRESHOLD_LONG
+    )
     expected = np.zeros(LONG_L, int)
     expected[10:21] = 1  # A: 10 .. 20 (frame 20 tied, frame 21 nearer to B)
     expected[21:31] = 2  # B: 21 .. 26 + 4
@@ -182,9 +208,34 @@ def test_decide_long_period_exact_tie_goes_to_the_earlier_run():
 
 
 def test_decide_long_period_segments_agree_with_labels():
-    labels, segments = decide_period(_long_scores({**RUN_A, **RUN_B}), LONG_CENTRES,
-                                     LONG_L, threshold_long=THRESHOLD_LONG)  # fmt: skip
+    labels, segments = decide_period(
+        _long_scores({**RUN_A, **RUN_B}),
+        LONG_CENTRES,
+        LONG_L,
+        threshold_long=THRESHOLD_LONG,
+    )
     assert_array_equal([s[:3] for s in segments], labels_to_segments(labels))
+
+
+def test_decide_long_period_adjacent_runs_of_one_class_stay_two_segments():
+    # A at centres 4-8 (extent 0-12), B at centres 12-16 (extent 8-20): frame 10
+    # is tied (earlier run A), frames 11-12 are nearer to B
+    runs = {
+        0: (0, 0.9),
+        1: (0, 0.9),
+        2: (0, 0.9),
+        4: (0, 0.8),
+        5: (0, 0.8),
+        6: (0, 0.8),
+    }
+    labels, segments = decide_period(
+        _long_scores(runs), LONG_CENTRES, LONG_L, threshold_long=THRESHOLD_LONG
+    )
+    expected = np.zeros(LONG_L, int)
+    expected[0:21] = 1
+    assert_array_equal(labels, expected)
+    assert [s[:3] for s in segments] == [(1, 0, 11), (1, 11, 21)]
+    assert_allclose([s[3] for s in segments], [0.9, 0.8])
 
 
 # --------------------------------------------------------------------------------
@@ -194,7 +245,11 @@ def test_decide_long_period_segments_agree_with_labels():
 STEPS = (4, 2)
 N_FEATURES = 4
 # Class means in feature space; frames are mean + N(0, 0.3).
-CLASS_MEANS = {1: (3.0, 0.0, 0.0, 0.0), 2: (0.0, 3.0, 0.0, 0.0), 3: (0.0, 0.0, 3.0, 0.0)}
+CLASS_MEANS = {
+    1: (3.0, 0.0, 0.0, 0.0),
+    2: (0.0, 3.0, 0.0, 0.0),
+    3: (0.0, 0.0, 3.0, 0.0),
+}
 REST_MEAN = (0.0, 0.0, 0.0, 3.0)
 CLIP_LENGTH = 30
 
@@ -280,8 +335,10 @@ def test_multiscale_confidence_is_the_mean_normalised_fused_score():
     assert_allclose(sa, sb, rtol=1e-12)
     # by hand: windows at centres 4, 6, .., 24 of the 30-frame clip (§6.2)
     centres = np.arange(4, 26, 2)
-    fused = sum(w * est.predict_proba(test[0][centres, k])
-                for k, (w, est) in enumerate(zip((0.75, 0.25), a.estimators_)))  # fmt: skip
+    fused = sum(
+        w * est.predict_proba(test[0][centres, k])
+        for k, (w, est) in enumerate(zip((0.75, 0.25), a.estimators_))
+    )
     top = fused.max(axis=1)
     assert_array_equal(fused.argmax(axis=1), 1)  # class 2 = classes_[1]
     assert_allclose(sa[0, 3], top[top > 0.5].mean(), rtol=1e-9)
@@ -361,8 +418,9 @@ def test_multiscale_predict_checks_window_width(fitted):
 def test_multiscale_random_state_seeds_every_scale():
     X, y = _clips([1, 2, 3])
     W = _windows(X)
-    net = TorchMLPClassifier(hidden_layer_sizes=(4,), activations=("tanh",),
-                             max_epochs=3, random_state=None)  # fmt: skip
+    net = TorchMLPClassifier(
+        hidden_layer_sizes=(4,), activations=("tanh",), max_epochs=3, random_state=None
+    )
     a = MultiScaleClassifier(net, steps=STEPS, random_state=0).fit(W, y)
     b = MultiScaleClassifier(net, steps=STEPS, random_state=0).fit(W, y)
     c = MultiScaleClassifier(net, steps=STEPS, random_state=1).fit(W, y)
@@ -381,8 +439,16 @@ def test_multiscale_memory_reuses_scale_estimators_across_decision_params(tmp_pa
     _clf(memory=memory).fit(W, y)
     n_cached = len(list(tmp_path.rglob("output.pkl")))
     assert n_cached == len(STEPS)
-    _clf(memory=memory, threshold_short=0.9, threshold_long=0.9, weights=(1, 3),
-         min_consecutive=4, short_length=40).fit(W, y)  # fmt: skip
+    _clf(
+        memory=memory,
+        threshold_short=0.9,
+        threshold_long=0.9,
+        weights=(1, 3),
+        min_consecutive=4,
+        short_length=40,
+    ).fit(W, y)
     assert len(list(tmp_path.rglob("output.pkl"))) == n_cached
-    MultiScaleClassifier(LogisticRegression(C=0.1), steps=STEPS, memory=memory).fit(W, y)
+    MultiScaleClassifier(LogisticRegression(C=0.1), steps=STEPS, memory=memory).fit(
+        W, y
+    )
     assert len(list(tmp_path.rglob("output.pkl"))) == 2 * n_cached

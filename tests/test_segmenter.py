@@ -62,8 +62,14 @@ def _stream(layout, seed):
 
 
 def _net(**params):
-    return TorchMLPClassifier(**{"hidden_layer_sizes": (8,), "activations": ("tanh",),
-                                 "max_epochs": 30, **params})  # fmt: skip
+    return TorchMLPClassifier(
+        **{
+            "hidden_layer_sizes": (8,),
+            "activations": ("tanh",),
+            "max_epochs": 30,
+            **params,
+        }
+    )
 
 
 def _periods(active):
@@ -100,9 +106,12 @@ def test_stream():
 
 @pytest.fixture(scope="module")
 def segmenter(train):
+    n_threads = torch.get_num_threads()
     torch.set_num_threads(1)
     X, y = train
-    return ActivitySegmenter(_net(), smooth_span=5, random_state=0).fit([X], [y])
+    seg = ActivitySegmenter(_net(), smooth_span=5, random_state=0).fit([X], [y])
+    torch.set_num_threads(n_threads)
+    return seg
 
 
 def test_segmenter_trains_on_gestures_and_nearby_rest_frames(train):
@@ -156,7 +165,7 @@ def test_segmenter_predict_proba_columns_are_rest_and_gesture(segmenter, test_st
     assert_allclose(proba[0].sum(axis=1), 1.0)
     gesture = y > 0
     assert proba[0][gesture, 1].mean() > 0.9
-    assert proba[0][~gesture, 1][: 20].mean() < 0.1
+    assert proba[0][~gesture, 1][:20].mean() < 0.1
 
 
 def test_segmenter_transform_masks_rest_rows(segmenter, test_stream):
@@ -215,20 +224,25 @@ def _n_cached(path):
 
 def test_segmenter_memory_reuses_the_network_across_decision_params(train, tmp_path):
     X, y = train
+    # random_state=None: a retrained network would get a new seed, so identical
+    # weights mean the cached network was reused
+    unseeded = [ActivitySegmenter(_net()).fit([X], [y]) for _ in range(2)]
+    assert not torch.equal(_state(unseeded[0])["net.0.weight"],
+                           _state(unseeded[1])["net.0.weight"])  # fmt: skip
     memory = joblib.Memory(tmp_path, verbose=0)
-    first = ActivitySegmenter(_net(), memory=memory, random_state=0).fit([X], [y])
+    first = ActivitySegmenter(_net(), memory=memory).fit([X], [y])
     assert _n_cached(tmp_path) == 1
-    torch.manual_seed(1234)  # a retrained network would start elsewhere
-    second = ActivitySegmenter(_net(), memory=memory, random_state=0, threshold=0.7,
-                               min_length=5, smooth_span=9).fit([X], [y])  # fmt: skip
+    second = ActivitySegmenter(
+        _net(), memory=memory, threshold=0.7, min_length=5, smooth_span=9
+    ).fit([X], [y])
     assert _n_cached(tmp_path) == 1
     for key, value in _state(first).items():
         assert torch.equal(value, _state(second)[key])
     # a change to the network retrains it
-    third = ActivitySegmenter(_net(hidden_layer_sizes=(6,)), memory=memory,
-                              random_state=0).fit([X], [y])  # fmt: skip
+    third = ActivitySegmenter(_net(hidden_layer_sizes=(6,)), memory=memory)
+    third.fit([X], [y])
     assert _n_cached(tmp_path) == 2
     assert _state(third)["net.0.weight"].shape == (6, 3)
     # so does a change of the training frames
-    ActivitySegmenter(_net(), memory=memory, random_state=0, n_context=5).fit([X], [y])
+    ActivitySegmenter(_net(), memory=memory, n_context=5).fit([X], [y])
     assert _n_cached(tmp_path) == 3

@@ -167,7 +167,9 @@ def test_period_windows_of_three_scales_share_the_step_4_centres():
     assert_array_equal(centres, np.arange(14, 26, 2))  # §6.2: a+4 .. b-4
     for row, c in enumerate(centres):
         for k, s in enumerate((4, 3, 2)):
-            assert_array_equal(windows[row, k], np.concatenate([D[c - s], D[c], D[c + s]]))
+            assert_array_equal(
+                windows[row, k], np.concatenate([D[c - s], D[c], D[c + s]])
+            )
 
 
 def test_period_resize_keeps_a_constant_period_constant():

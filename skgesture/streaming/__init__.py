@@ -1,4 +1,70 @@
-"""Streaming recognition (temporary init)."""
+"""Live recognition: streaming recogniser, commands, a robot, skeleton sources.
+
+* :class:`StreamingRecognizer` pushes frames through a fitted Method A, B or C
+  pipeline and returns :class:`GestureEvent` objects as soon as they are
+  certain (causal, constant work and memory per frame).
+* :class:`ActionMap`, :class:`PickAndPlaceRobot` / :class:`SimulatedRobot`
+  (with :class:`RobotCommand`, :class:`RobotState`) and
+  :class:`GestureCommander` turn events into the paper's pick-and-place
+  commands.
+* Adapters map Kinect v2, Azure Kinect, MediaPipe Pose and MSR Action3D
+  skeletons to the Kinect v1 layout of the models; :class:`SkeletonSource`
+  is the interface of a live source and :class:`ReplaySource` replays a
+  recording.
+
+See ``docs/streaming.md`` for the timing and the differences from offline
+``predict``.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from skgesture.streaming._actions import (
+    ActionDecision,
+    ActionMap,
+    CommandResult,
+    GestureCommander,
+    PickAndPlaceRobot,
+    RobotCommand,
+    RobotState,
+    SimulatedRobot,
+)
+from skgesture.streaming._adapters import (
+    AZURE_KINECT_JOINTS,
+    KINECT_V2_JOINTS,
+    MEDIAPIPE_POSE_LANDMARKS,
+    AzureKinectAdapter,
+    KinectV1Adapter,
+    KinectV2Adapter,
+    MediaPipePoseAdapter,
+    MSRAction3DAdapter,
+    ReplaySource,
+    SkeletonAdapter,
+    SkeletonSource,
+    get_adapter,
+)
 from skgesture.streaming._recognizer import GestureEvent, StreamingRecognizer
 
-__all__ = ["GestureEvent", "StreamingRecognizer"]
+__all__ = [
+    "AZURE_KINECT_JOINTS",
+    "KINECT_V2_JOINTS",
+    "MEDIAPIPE_POSE_LANDMARKS",
+    "ActionDecision",
+    "ActionMap",
+    "AzureKinectAdapter",
+    "CommandResult",
+    "GestureCommander",
+    "GestureEvent",
+    "KinectV1Adapter",
+    "KinectV2Adapter",
+    "MSRAction3DAdapter",
+    "MediaPipePoseAdapter",
+    "PickAndPlaceRobot",
+    "ReplaySource",
+    "RobotCommand",
+    "RobotState",
+    "SimulatedRobot",
+    "SkeletonAdapter",
+    "SkeletonSource",
+    "StreamingRecognizer",
+    "get_adapter",
+]

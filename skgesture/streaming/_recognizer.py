@@ -26,6 +26,7 @@ class docstring and in ``docs/streaming.md``.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import warnings
 from dataclasses import dataclass
 from numbers import Integral, Real
 
@@ -707,6 +708,7 @@ class StreamingRecognizer:
 
     def _reset_run(self):
         self._run_start = None
+        self._length = 0
         self._open = False
         self._long = False
         self._next_centre = 0
@@ -715,6 +717,7 @@ class StreamingRecognizer:
         self._rec = []
         self._scan_pos = 0
         self._run_first = 0
+        self._pending = []  # finished runs (first, end window) not yet final
         self._emitted = set()
 
     def _on_activity(self, u, active, now):
@@ -727,7 +730,7 @@ class StreamingRecognizer:
         if self._run_start is None:
             self._run_start = u
             self._next_centre = u + self._half
-        n_active = u - self._run_start + 1
+        n_active = self._length = u - self._run_start + 1
         if not self._open and n_active >= self._min_length:
             self._open = True
         if not self._open:
@@ -767,29 +770,52 @@ class StreamingRecognizer:
         self._rec.extend(np.where(top > thr, best, -1).tolist())
 
     def _scan_runs(self, now):
-        """Long period: emit every run of windows that a later window ended."""
-        rec = self._rec
-        for i in range(self._scan_pos, len(rec)):
-            if i > 0 and rec[i] != rec[i - 1]:
-                self._emit_run(self._run_first, i, now)
-            if i == 0 or rec[i] != rec[i - 1]:
-                self._run_first = i
-        self._scan_pos = len(rec)
+        """Long period: emit the runs of windows that no later window can change.
 
-    def _emit_run(self, a, b, now):
-        """Emit windows ``a .. b - 1`` (one class) if they make a run."""
+        A frame belongs to a run only inside the run's extent (its centres
+        +- ``hw``) and goes to the nearest centre, the earlier run on ties
+        (METHOD_SPEC §5.5, decision D17). A finished run whose last centre is
+        ``c`` is therefore final once every window that could still join a
+        qualifying run is centred at ``c + 2 hw`` or later: the next window to
+        come, or the first window of a trailing run of one class still shorter
+        than ``min_consecutive``.
+        """
+        rec, n = self._rec, len(self._rec)
+        min_run = self._decide_kwargs["min_consecutive"]
+        for i in range(self._scan_pos, n):
+            if i > 0 and rec[i] != rec[i - 1]:
+                a = self._run_first
+                if rec[a] >= 0 and i - a >= min_run:
+                    self._pending.append((a, i))
+                self._run_first = i
+        self._scan_pos = n
+        if not self._pending:
+            return
+        first = self._run_first
+        if rec[first] >= 0 and n - first < min_run:
+            frontier = self._win_centres[first]
+        else:
+            frontier = self._win_centres[-1] + self._stride
+        while self._pending:
+            a, b = self._pending[0]
+            if self._win_centres[b - 1] + 2 * self._half > frontier:
+                break
+            self._pending.pop(0)
+            self._emit_run(a, now)
+
+    def _emit_run(self, a, now):
+        """Emit the segment of the run starting at window ``a``, decided with
+        the offline rule on every window of the period so far."""
         from skgesture._multiscale import decide_period
 
-        if self._rec[a] < 0 or b - a < self._decide_kwargs["min_consecutive"]:
-            return
-        centres = np.asarray(self._win_centres[a:b])
-        kwargs = dict(self._decide_kwargs, short_length=0)  # the long-period rule
         _, segs = decide_period(
-            np.asarray(self._win_scores[a:b]), centres,
-            int(centres[-1]) + self._half + 1, **kwargs,
+            np.asarray(self._win_scores), np.asarray(self._win_centres),
+            self._length, **self._decide_kwargs,
         )  # fmt: skip
+        c0 = self._win_centres[a]
         for seg in segs:
-            self._emit_segment(seg, now)
+            if seg[1] <= c0 < seg[2]:
+                self._emit_segment(seg, now)
 
     def _emit_segment(self, seg, now):
         cls, lo, hi, conf = seg
@@ -836,6 +862,15 @@ class StreamingRecognizer:
             )  # fmt: skip
             scores = self._fused_scores(wins)
         _, segs = decide_period(scores, centres, length, **self._decide_kwargs)
+        final = {(int(c), int(lo), int(hi)) for c, lo, hi, _ in segs}
+        if not self._emitted <= final:
+            warnings.warn(
+                "StreamingRecognizer emitted a gesture that the offline decision "
+                "rule no longer gives at the end of its period; the rule of "
+                "decide_period changed in a way the early emission does not know",
+                RuntimeWarning,
+                stacklevel=2,
+            )
         for seg in segs:
             self._emit_segment(seg, now)
 

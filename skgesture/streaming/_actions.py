@@ -1,0 +1,435 @@
+"""From gesture events to robot commands: action map and pick-and-place robot.
+
+The paper commands a collaborative robot with five gestures that drive a
+pick-and-place task: move to the tool, close the gripper, carry the tool, open
+the gripper, return home. :class:`ActionMap` turns gesture events into
+commands (confidence floor, refractory period: one gesture, one command);
+:class:`PickAndPlaceRobot` is the task's state machine, which refuses commands
+out of order, with :class:`SimulatedRobot` as a ready-made implementation and
+the place where a real robot plugs in (:meth:`PickAndPlaceRobot._perform`);
+:class:`GestureCommander` wires a recogniser, a map and a robot together.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from enum import Enum
+from numbers import Integral, Real
+
+__all__ = [
+    "RobotCommand",
+    "RobotState",
+    "CommandResult",
+    "PickAndPlaceRobot",
+    "SimulatedRobot",
+    "ActionDecision",
+    "ActionMap",
+    "GestureCommander",
+]
+
+
+class RobotCommand(str, Enum):
+    """The five actions of the paper's pick-and-place task, in task order."""
+
+    MOVE_TO_TOOL = "move_to_tool"
+    CLOSE_GRIPPER = "close_gripper"
+    CARRY_TOOL = "carry_tool"
+    OPEN_GRIPPER = "open_gripper"
+    RETURN_HOME = "return_home"
+
+    def __str__(self):
+        return self.value
+
+
+class RobotState(str, Enum):
+    """States of the pick-and-place cycle."""
+
+    HOME = "home"  # gripper open, empty, at the home pose
+    AT_TOOL = "at_tool"  # gripper open around the tool
+    HOLDING = "holding"  # gripper closed on the tool, at its pick-up place
+    CARRIED = "carried"  # tool held at its target place
+    RELEASED = "released"  # tool left at the target, gripper open
+
+    def __str__(self):
+        return self.value
+
+
+# The cycle: state -> (the one command accepted there, the state it leads to).
+TRANSITIONS = {
+    RobotState.HOME: (RobotCommand.MOVE_TO_TOOL, RobotState.AT_TOOL),
+    RobotState.AT_TOOL: (RobotCommand.CLOSE_GRIPPER, RobotState.HOLDING),
+    RobotState.HOLDING: (RobotCommand.CARRY_TOOL, RobotState.CARRIED),
+    RobotState.CARRIED: (RobotCommand.OPEN_GRIPPER, RobotState.RELEASED),
+    RobotState.RELEASED: (RobotCommand.RETURN_HOME, RobotState.HOME),
+}
+_HOLDS_TOOL = {RobotState.HOLDING, RobotState.CARRIED}
+
+# Why a command is refused, for the cases worth a specific message.
+_REASONS = {
+    (RobotState.HOME, RobotCommand.RETURN_HOME): "already home",
+    (RobotState.AT_TOOL, RobotCommand.MOVE_TO_TOOL): "already at the tool",
+    (RobotState.HOLDING, RobotCommand.CLOSE_GRIPPER): "the gripper is already closed",
+    (RobotState.CARRIED, RobotCommand.CARRY_TOOL): "the tool is already carried",
+    (RobotState.CARRIED, RobotCommand.CLOSE_GRIPPER): "the gripper is already closed",
+    (RobotState.RELEASED, RobotCommand.OPEN_GRIPPER): "the gripper is already open",
+    (RobotState.HOME, RobotCommand.CLOSE_GRIPPER): "the gripper is not at the tool",
+    (RobotState.RELEASED, RobotCommand.CLOSE_GRIPPER): "the gripper is not at the tool",
+    (RobotState.HOLDING, RobotCommand.OPEN_GRIPPER):
+        "the tool has not been carried to its target yet",
+}  # fmt: skip
+
+
+def _refusal(state, command):
+    if (state, command) in _REASONS:
+        return _REASONS[(state, command)]
+    if command is RobotCommand.OPEN_GRIPPER and state not in _HOLDS_TOOL:
+        return "the gripper holds nothing"
+    if command is RobotCommand.CARRY_TOOL and state not in _HOLDS_TOOL:
+        return "no tool is held"
+    if state in _HOLDS_TOOL:
+        return f"a tool is held: {TRANSITIONS[state][0]} comes next"
+    return f"out of order: {TRANSITIONS[state][0]} comes next in state {state}"
+
+
+@dataclass(frozen=True)
+class CommandResult:
+    """What a robot did with one command.
+
+    Parameters
+    ----------
+    command : RobotCommand
+        The command.
+    accepted : bool
+        Whether it was executed.
+    state_before, state_after : RobotState
+        Robot state around it (equal when refused).
+    reason : str
+        ``"ok"`` or why it was refused.
+    frame : int or None, default=None
+        Stream frame at which it was issued.
+    """
+
+    command: RobotCommand
+    accepted: bool
+    state_before: RobotState
+    state_after: RobotState
+    reason: str
+    frame: int | None = None
+
+
+class PickAndPlaceRobot(ABC):
+    """The paper's pick-and-place task as a state machine; subclass per robot.
+
+    ``home -> at_tool -> holding -> carried -> released -> home`` through
+    ``move_to_tool``, ``close_gripper``, ``carry_tool``, ``open_gripper`` and
+    ``return_home``. :meth:`execute` accepts only the next command of the cycle:
+    any other is refused with a reason (e.g. opening a gripper that holds
+    nothing), the state does not change and the refusal is logged.
+
+    To drive a real robot, subclass and implement :meth:`_perform` with the
+    vendor's API (move to a taught pose, close/open the gripper); raise an
+    exception there to refuse a command the hardware could not carry out. The
+    state machine, the refusals and the log stay the same.
+
+    Attributes
+    ----------
+    state : RobotState
+        Current state.
+    log : list of CommandResult
+        Every command received, accepted or not.
+    """
+
+    def __init__(self):
+        self.state = RobotState.HOME
+        self.log = []
+
+    def execute(self, command, frame=None):
+        """Carry out ``command`` if it is the next step of the task.
+
+        Parameters
+        ----------
+        command : RobotCommand or str
+            The command (``"open_gripper"`` works too).
+        frame : int or None, default=None
+            Stream frame, kept in the log.
+
+        Returns
+        -------
+        CommandResult
+            Accepted or refused, with the reason.
+        """
+        command = RobotCommand(command)
+        before = self.state
+        expected, after = TRANSITIONS[before]
+        if command is not expected:
+            result = CommandResult(command, False, before, before,
+                                   _refusal(before, command), frame)
+        else:
+            try:
+                self._perform(command)
+            except Exception as exc:  # the hardware refused: state unchanged
+                result = CommandResult(command, False, before, before,
+                                       f"robot error: {exc}", frame)
+            else:
+                self.state = after
+                result = CommandResult(command, True, before, after, "ok", frame)
+        self.log.append(result)
+        return result
+
+    @property
+    def holding(self):
+        """Whether the gripper holds the tool."""
+        return self.state in _HOLDS_TOOL
+
+    def status(self):
+        """Current state in words.
+
+        Returns
+        -------
+        dict
+            ``state``, ``next_command``, ``gripper`` (``"open"``/``"closed"``),
+            ``holding`` (bool), ``n_accepted`` and ``n_refused``.
+        """
+        n_ok = sum(r.accepted for r in self.log)
+        return {
+            "state": self.state.value,
+            "next_command": TRANSITIONS[self.state][0].value,
+            "gripper": "closed" if self.holding else "open",
+            "holding": self.holding,
+            "n_accepted": n_ok,
+            "n_refused": len(self.log) - n_ok,
+        }
+
+    def reset(self):
+        """Back to ``home`` with an empty log (the simulated robot only)."""
+        self.state = RobotState.HOME
+        self.log = []
+
+    @abstractmethod
+    def _perform(self, command):
+        """Make the robot do ``command`` (called only for an in-order command)."""
+
+
+class SimulatedRobot(PickAndPlaceRobot):
+    """A pick-and-place robot that only records what it would do.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import SimulatedRobot
+    >>> robot = SimulatedRobot()
+    >>> robot.execute("open_gripper").reason
+    'the gripper holds nothing'
+    >>> [robot.execute(c).accepted for c in ("move_to_tool", "close_gripper")]
+    [True, True]
+    >>> robot.status()["state"], robot.status()["gripper"], robot.status()["n_refused"]
+    ('holding', 'closed', 1)
+    """
+
+    def __init__(self):
+        super().__init__()
+        self.actions = []
+
+    def _perform(self, command):
+        self.actions.append(command)
+
+    def reset(self):
+        """Back to ``home`` with empty logs."""
+        super().reset()
+        self.actions = []
+
+
+@dataclass(frozen=True)
+class ActionDecision:
+    """What an :class:`ActionMap` made of one gesture event.
+
+    Parameters
+    ----------
+    event : GestureEvent
+        The event.
+    command : object or None
+        The command issued, None when the event was ignored.
+    reason : str
+        ``"issued"`` or why the event was ignored.
+    """
+
+    event: object
+    command: object
+    reason: str
+
+    @property
+    def issued(self):
+        """Whether a command was issued."""
+        return self.command is not None
+
+
+class ActionMap:
+    """Maps gesture classes to commands, once per gesture.
+
+    An event is turned into its class's command when its confidence reaches
+    ``min_confidence`` and no command was issued in the last
+    ``refractory_frames`` frames (counted between the frames at which the
+    events were emitted), so that one gesture, even if it is recognised as two
+    overlapping events, gives one command.
+
+    Parameters
+    ----------
+    mapping : dict
+        ``{gesture class: command}``; commands are :class:`RobotCommand`
+        values (strings such as ``"close_gripper"`` are converted) or any
+        object for other programs.
+    min_confidence : float, default=0.0
+        Confidence floor.
+    refractory_frames : int, default=0
+        Frames after an issued command during which events are ignored.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import ActionMap, GestureEvent
+    >>> amap = ActionMap({1: "move_to_tool", 2: "close_gripper"},
+    ...                  min_confidence=0.7, refractory_frames=20)
+    >>> ev = GestureEvent(label=1, start=0, end=40, confidence=0.9, emitted_at=52)
+    >>> str(amap.decide(ev).command)
+    'move_to_tool'
+    >>> late = GestureEvent(label=2, start=30, end=50, confidence=0.95, emitted_at=62)
+    >>> amap.decide(late).reason
+    'refractory: 10 frames after the last command (< 20)'
+    """
+
+    def __init__(self, mapping, *, min_confidence=0.0, refractory_frames=0):
+        if not isinstance(min_confidence, Real) or not 0 <= min_confidence <= 1:
+            raise ValueError(f"min_confidence must be in [0, 1], got {min_confidence!r}")
+        if not isinstance(refractory_frames, Integral) or refractory_frames < 0:
+            raise ValueError(
+                f"refractory_frames must be a non-negative int, got {refractory_frames!r}"
+            )
+        self.mapping = {int(k): _as_command(v) for k, v in dict(mapping).items()}
+        self.min_confidence = min_confidence
+        self.refractory_frames = refractory_frames
+        self.reset()
+
+    def reset(self):
+        """Forget the last issued command."""
+        self._last_issued = None
+
+    def decide(self, event):
+        """The command for one event, or why there is none.
+
+        Parameters
+        ----------
+        event : GestureEvent
+            A recognised gesture.
+
+        Returns
+        -------
+        ActionDecision
+            With ``command`` None when the event is ignored.
+        """
+        command = self.mapping.get(int(event.label))
+        if command is None:
+            return ActionDecision(event, None, f"class {event.label} has no command")
+        if event.confidence < self.min_confidence:
+            return ActionDecision(
+                event, None,
+                f"confidence {event.confidence:.2f} < {self.min_confidence:g}",
+            )  # fmt: skip
+        if self._last_issued is not None:
+            gap = event.emitted_at - self._last_issued
+            if gap < self.refractory_frames:
+                return ActionDecision(
+                    event, None,
+                    f"refractory: {gap} frames after the last command "
+                    f"(< {self.refractory_frames})",
+                )  # fmt: skip
+        self._last_issued = event.emitted_at
+        return ActionDecision(event, command, "issued")
+
+    __call__ = decide
+
+
+def _as_command(value):
+    try:
+        return RobotCommand(value)
+    except ValueError:
+        return value
+
+
+class GestureCommander:
+    """Recogniser -> action map -> robot, frame by frame.
+
+    Parameters
+    ----------
+    recognizer : StreamingRecognizer
+        Gives gesture events.
+    action_map : ActionMap
+        Turns them into commands.
+    robot : PickAndPlaceRobot
+        Executes the commands.
+
+    Attributes
+    ----------
+    log : list of tuple
+        ``(decision, result)`` for every event: the :class:`ActionDecision`
+        and the robot's :class:`CommandResult` (None when no command was
+        issued).
+    """
+
+    def __init__(self, recognizer, action_map, robot):
+        self.recognizer = recognizer
+        self.action_map = action_map
+        self.robot = robot
+        self.log = []
+
+    def push(self, frame):
+        """Push one frame; act on the events it completes.
+
+        Parameters
+        ----------
+        frame : array-like of shape (20, 3)
+            Kinect v1 frame.
+
+        Returns
+        -------
+        list of tuple
+            New ``(decision, result)`` pairs.
+        """
+        return self._act(self.recognizer.push(frame))
+
+    def flush(self):
+        """End the stream and act on the last events.
+
+        Returns
+        -------
+        list of tuple
+            New ``(decision, result)`` pairs.
+        """
+        return self._act(self.recognizer.flush())
+
+    def run(self, source):
+        """Drive the robot from every frame of a source, then flush.
+
+        Parameters
+        ----------
+        source : iterable of ndarray of shape (20, 3)
+            A :class:`SkeletonSource` or any iterable of Kinect v1 frames.
+
+        Returns
+        -------
+        list of tuple
+            The whole :attr:`log`.
+        """
+        for frame in source:
+            self.push(frame)
+        self.flush()
+        return self.log
+
+    def _act(self, events):
+        out = []
+        for event in events:
+            decision = self.action_map.decide(event)
+            result = None
+            if decision.issued:
+                result = self.robot.execute(decision.command, frame=event.emitted_at)
+            out.append((decision, result))
+        self.log += out
+        return out
