@@ -30,8 +30,17 @@ def _frame_features(seq, half_window, step):
 class SlidingWindowForest(ClassifierMixin, BaseEstimator):
     """Random forest on a short window of framewise joint features, smoothed."""
 
-    def __init__(self, *, n_estimators=100, half_window=4, step=2, smooth=9, min_run=8,
-                 n_jobs=2, random_state=None):
+    def __init__(
+        self,
+        *,
+        n_estimators=100,
+        half_window=4,
+        step=2,
+        smooth=9,
+        min_run=8,
+        n_jobs=2,
+        random_state=None,
+    ):
         self.n_estimators = n_estimators
         self.half_window = half_window
         self.step = step
@@ -45,7 +54,9 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
         y = check_sequence_labels(y, X)
         F = np.concatenate([_frame_features(s, self.half_window, self.step) for s in X])
         self.forest_ = RandomForestClassifier(
-            n_estimators=self.n_estimators, n_jobs=self.n_jobs, min_samples_leaf=2,
+            n_estimators=self.n_estimators,
+            n_jobs=self.n_jobs,
+            min_samples_leaf=2,
             random_state=self.random_state,
         ).fit(F, np.concatenate(y))
         self.classes_ = self.forest_.classes_
@@ -55,7 +66,9 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
         X = check_sequences(X, ndim=3, allow_nan=True)
         out = []
         for s in X:
-            p = self.forest_.predict_proba(_frame_features(s, self.half_window, self.step))
+            p = self.forest_.predict_proba(
+                _frame_features(s, self.half_window, self.step)
+            )
             p = uniform_filter1d(p, self.smooth, axis=0, mode="nearest")
             lab = self.classes_[np.argmax(p, axis=1)]
             out.append(remove_short_runs(lab, self.min_run))

@@ -69,7 +69,8 @@ def machine_line():
     import torch
 
     return (
-        f"{platform.node()} · {os.cpu_count()} cores · Python {platform.python_version()}"
+        f"{platform.node()} · {os.cpu_count()} cores"
+        f" · Python {platform.python_version()}"
         f" · numpy {numpy.__version__} · scikit-learn {sklearn.__version__}"
         f" · torch {torch.__version__}"
     )

@@ -1,8 +1,8 @@
 """Speed of the PoseDescriptor and of the synthetic stream generator (issue 2)."""
 
-import numpy as np
 
 from _common import median_time, one_core
+
 from skgesture import PoseDescriptor
 from skgesture.datasets import make_gesture_streams
 
@@ -17,25 +17,30 @@ def run(quick=False):
         for joints in ("paper11", "full20"):
             desc = PoseDescriptor(joints=joints).fit(data.X)
             med, times = median_time(lambda: desc.transform(data.X), repeat=5)
-            rows.append({
-                "what": f"PoseDescriptor.transform ({joints}, {desc.n_features_out_}-D)",
-                "frames": n_frames,
-                "median s": med,
-                "frames/s": n_frames / med,
-                "µs/frame": 1e6 * med / n_frames,
-            })
+            rows.append(
+                {
+                    "what": f"PoseDescriptor ({joints}, {desc.n_features_out_}-D)",
+                    "frames": n_frames,
+                    "median s": med,
+                    "frames/s": n_frames / med,
+                    "µs/frame": 1e6 * med / n_frames,
+                }
+            )
         n_gen = 200 if quick else 1000
-        med, _ = median_time(lambda: make_gesture_streams(n_gen, random_state=1), repeat=3,
-                             warmup=0)
+        med, _ = median_time(
+            lambda: make_gesture_streams(n_gen, random_state=1), repeat=3, warmup=0
+        )
         gen = make_gesture_streams(n_gen, random_state=1)
         gen_frames = sum(len(x) for x in gen.X)
-        rows.append({
-            "what": f"make_gesture_streams({n_gen})",
-            "frames": gen_frames,
-            "median s": med,
-            "frames/s": gen_frames / med,
-            "µs/frame": 1e6 * med / gen_frames,
-        })
+        rows.append(
+            {
+                "what": f"make_gesture_streams({n_gen})",
+                "frames": gen_frames,
+                "median s": med,
+                "frames/s": gen_frames / med,
+                "µs/frame": 1e6 * med / gen_frames,
+            }
+        )
     return rows
 
 

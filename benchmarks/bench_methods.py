@@ -8,9 +8,9 @@
 import time
 
 import numpy as np
+from _baseline import SlidingWindowForest
 from sklearn.model_selection import LeaveOneGroupOut
 
-from _baseline import SlidingWindowForest
 from skgesture import make_method_a, make_method_b
 from skgesture.datasets import load_precog, make_gesture_streams
 from skgesture.metrics import frame_accuracy, jaccard_index
@@ -65,34 +65,58 @@ def precog_rows(quick=False, include_c=False, random_state=0):
     for name, make in _methods("full20", random_state, include_c).items():
         per_fold = []
         for tr, te in folds:
-            per_fold.append(_evaluate(
-                make, [data.X[i] for i in tr], [data.y[i] for i in tr],
-                [data.X[i] for i in te], [data.y[i] for i in te],
-            ))
-        rows.append({"data": f"PRECOG LOSO ({len(folds)} folds)", "method": name,
-                     **_mean_rows(per_fold)})
+            per_fold.append(
+                _evaluate(
+                    make,
+                    [data.X[i] for i in tr],
+                    [data.y[i] for i in tr],
+                    [data.X[i] for i in te],
+                    [data.y[i] for i in te],
+                )
+            )
+        rows.append(
+            {
+                "data": f"PRECOG LOSO ({len(folds)} folds)",
+                "method": name,
+                **_mean_rows(per_fold),
+            }
+        )
     return rows
 
 
 def synthetic_rows(quick=False, include_c=False, random_state=0):
     n_train, n_test = (30, 15) if quick else (100, 50)
-    data = make_gesture_streams(n_train + n_test, n_subjects=(n_train + n_test) // 5,
-                                random_state=random_state)
+    data = make_gesture_streams(
+        n_train + n_test, n_subjects=(n_train + n_test) // 5, random_state=random_state
+    )
     groups = np.asarray(data.groups)
     # Unseen subjects: the last subjects go to the test set.
-    test_subjects = np.unique(groups)[-(n_test // 5):]
+    test_subjects = np.unique(groups)[-(n_test // 5) :]
     te = np.flatnonzero(np.isin(groups, test_subjects))
     tr = np.flatnonzero(~np.isin(groups, test_subjects))
     rows = []
     for name, make in _methods("paper11", random_state, include_c).items():
-        row = _evaluate(make, [data.X[i] for i in tr], [data.y[i] for i in tr],
-                        [data.X[i] for i in te], [data.y[i] for i in te])
+        row = _evaluate(
+            make,
+            [data.X[i] for i in tr],
+            [data.y[i] for i in tr],
+            [data.X[i] for i in te],
+            [data.y[i] for i in te],
+        )
         rows.append({"data": f"synthetic {len(tr)}/{len(te)}", "method": name, **row})
     return rows
 
 
-COLUMNS = ["data", "method", "jaccard", "jaccard_fp", "frame_acc", "segmenter_acc",
-           "fit_s", "pred_us_per_frame"]
+COLUMNS = [
+    "data",
+    "method",
+    "jaccard",
+    "jaccard_fp",
+    "frame_acc",
+    "segmenter_acc",
+    "fit_s",
+    "pred_us_per_frame",
+]
 
 
 def run(quick=False, include_c=False):
@@ -104,5 +128,10 @@ if __name__ == "__main__":
 
     from _common import format_table
 
-    print(format_table(run(quick="--quick" in sys.argv, include_c="--c" in sys.argv),
-                       COLUMNS, "Jaccard and cost per method"))
+    print(
+        format_table(
+            run(quick="--quick" in sys.argv, include_c="--c" in sys.argv),
+            COLUMNS,
+            "Jaccard and cost per method",
+        )
+    )

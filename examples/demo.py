@@ -38,10 +38,14 @@ def summarise(name, data):
     counts = np.bincount(seg[:, 0], minlength=len(data.target_names) + 1)[1:]
     missing = int(sum(m.sum() for m in data.missing))
     print(f"\n{name}")
-    print(f"  sequences {len(data.X)}, frames {n_frames:,}, untracked frames {missing}, "
-          f"subjects {len(np.unique(data.groups))}")
-    print(f"  gestures {len(seg)}; length min {lengths.min()}, median "
-          f"{np.median(lengths):.0f}, max {lengths.max()} frames")
+    print(
+        f"  sequences {len(data.X)}, frames {n_frames:,}, untracked frames {missing}, "
+        f"subjects {len(np.unique(data.groups))}"
+    )
+    print(
+        f"  gestures {len(seg)}; length min {lengths.min()}, median "
+        f"{np.median(lengths):.0f}, max {lengths.max()} frames"
+    )
     per_class = ", ".join(f"{n}: {c}" for n, c in zip(data.target_names, counts))
     print(f"  per class: {per_class}")
 
@@ -58,10 +62,15 @@ def make_pipeline(method, random_state, memory):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[1])
-    parser.add_argument("--method", choices=["A", "B", "C"], default="B",
-                        help="which of the paper's methods to train (default B)")
-    parser.add_argument("--no-search", action="store_true",
-                        help="skip the GridSearchCV example")
+    parser.add_argument(
+        "--method",
+        choices=["A", "B", "C"],
+        default="B",
+        help="which of the paper's methods to train (default B)",
+    )
+    parser.add_argument(
+        "--no-search", action="store_true", help="skip the GridSearchCV example"
+    )
     parser.add_argument("--random-state", type=int, default=0)
     args = parser.parse_args(argv)
 
@@ -78,8 +87,10 @@ def main(argv=None):
     D = PoseDescriptor().fit_transform(synth.X)
     dt = time.perf_counter() - t0
     n = sum(len(d) for d in D)
-    print(f"\nPoseDescriptor: {n:,} frames -> {D[0].shape[1]}-D in {dt:.2f} s "
-          f"({n / dt:,.0f} frames/s, fit + transform)")
+    print(
+        f"\nPoseDescriptor: {n:,} frames -> {D[0].shape[1]}-D in {dt:.2f} s "
+        f"({n / dt:,.0f} frames/s, fit + transform)"
+    )
 
     # %%
     # Train on subjects 1-6, test on the unseen subjects 7-8.
@@ -95,11 +106,15 @@ def main(argv=None):
         model.fit(X_tr, y_tr)
         fit_s = time.perf_counter() - t0
         pred = model.predict(X_te)
-        print(f"\nMethod {args.method} on PRECOG, trained on subjects 1-6 "
-              f"({len(train)} sequences) in {fit_s:.1f} s; held-out subjects 7-8:")
-        print(f"  Jaccard (official 2014) {jaccard_index(y_te, pred):.3f}, "
-              f"fp-penalised {jaccard_index(y_te, pred, mode='fp_penalised'):.3f}, "
-              f"frame accuracy {frame_accuracy(y_te, pred):.3f}")
+        print(
+            f"\nMethod {args.method} on PRECOG, trained on subjects 1-6 "
+            f"({len(train)} sequences) in {fit_s:.1f} s; held-out subjects 7-8:"
+        )
+        print(
+            f"  Jaccard (official 2014) {jaccard_index(y_te, pred):.3f}, "
+            f"fp-penalised {jaccard_index(y_te, pred, mode='fp_penalised'):.3f}, "
+            f"frame accuracy {frame_accuracy(y_te, pred):.3f}"
+        )
 
         # %%
         # Decision parameters are tuned without retraining: the networks are
@@ -110,16 +125,21 @@ def main(argv=None):
                 "classifier__threshold_short": [0.5, 0.6014],
                 "classifier__threshold_long": [0.45, 0.6033],
             }
-            search = GridSearchCV(model, grid, scoring=jaccard_scorer,
-                                  cv=GroupKFold(n_splits=2))
+            search = GridSearchCV(
+                model, grid, scoring=jaccard_scorer, cv=GroupKFold(n_splits=2)
+            )
             t0 = time.perf_counter()
             search.fit(X_tr, y_tr, groups=groups[train])
             n_cand = len(search.cv_results_["params"])
-            print(f"\nGridSearchCV over fusion weights and thresholds: {n_cand} "
-                  f"candidates x 2 folds in {time.perf_counter() - t0:.1f} s")
+            print(
+                f"\nGridSearchCV over fusion weights and thresholds: {n_cand} "
+                f"candidates x 2 folds in {time.perf_counter() - t0:.1f} s"
+            )
             print(f"  best {search.best_params_}")
-            print(f"  cross-validated Jaccard {search.best_score_:.3f}; on subjects 7-8 "
-                  f"{jaccard_index(y_te, search.predict(X_te)):.3f}")
+            print(
+                f"  cross-validated Jaccard {search.best_score_:.3f}; on subjects 7-8 "
+                f"{jaccard_index(y_te, search.predict(X_te)):.3f}"
+            )
 
 
 if __name__ == "__main__":

@@ -14,7 +14,12 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
-from skgesture.layouts import KINECT_V1, N_COORDS, DescriptorJoints, get_descriptor_joints
+from skgesture.layouts import (
+    KINECT_V1,
+    N_COORDS,
+    DescriptorJoints,
+    get_descriptor_joints,
+)
 from skgesture.utils._validation import check_sequences, missing_frames
 
 __all__ = ["PoseDescriptor"]
@@ -200,9 +205,9 @@ def _angles(P, triples, u_x, u_z):
     b2 = pk - pj
     b2p, ok_b2 = _unit(b2 - np.einsum("tki,tki->tk", b2, b1)[..., None] * b1)
     ux = u_x[:, None, :]
-    up, ok_u = _unit(ux - np.einsum("tki,tki->tk", np.broadcast_to(ux, b1.shape), b1)[
-        ..., None
-    ] * b1)
+    up, ok_u = _unit(
+        ux - np.einsum("tki,tki->tk", np.broadcast_to(ux, b1.shape), b1)[..., None] * b1
+    )
     azimuth = _angle(b2p, up, ok_a & ok_b2 & ok_u, 0.0)
 
     pos, ok_p = _unit(P)
@@ -219,7 +224,11 @@ def _distances(P, pairs):
     T, J = P.shape[:2]
     G = np.einsum("tic,tjc->tij", P, P).reshape(T, J * J)
     sq = G[:, :: J + 1]
-    d2 = sq[:, pairs[:, 0]] + sq[:, pairs[:, 1]] - 2.0 * G[:, pairs[:, 0] * J + pairs[:, 1]]
+    d2 = (
+        sq[:, pairs[:, 0]]
+        + sq[:, pairs[:, 1]]
+        - 2.0 * G[:, pairs[:, 0] * J + pairs[:, 1]]
+    )
     return np.sqrt(np.maximum(d2, 0.0))
 
 
@@ -374,7 +383,9 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
             filled.append(q[~miss])
             valid_seq.append(i)
         if not filled:
-            raise ValueError("every sequence of X is untracked (all-zero or NaN frames)")
+            raise ValueError(
+                "every sequence of X is untracked (all-zero or NaN frames)"
+            )
         allq = np.concatenate(filled)
         links = spec["links"]
         self.link_lengths_ = _norm(allq[:, links[:, 1]] - allq[:, links[:, 0]]).mean(
@@ -481,7 +492,9 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
             # No tracked frame: the standardised descriptor is all zeros.
             return np.broadcast_to(self.mean_, (T, self.n_features_out_)).copy()
         if self.link_normalisation:
-            q = _link_normalise(q, spec["links"], self.link_lengths_, self.link_direction)
+            q = _link_normalise(
+                q, spec["links"], self.link_lengths_, self.link_direction
+            )
         P = q[:, spec["keep"]]
         if self.sigma > 0:
             P = _smooth_time(P, gaussian_kernel(self.sigma), self.border)
@@ -496,7 +509,15 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
             spine = _norm(P[:, hi] - P[:, lo])[:, None]
             dist = dist / np.where(spine > MIN_NORM, spine, 1.0)
         return np.concatenate(
-            [P.reshape(T, -1), vel.reshape(T, -1), acc.reshape(T, -1), incl, azim, bend, dist],
+            [
+                P.reshape(T, -1),
+                vel.reshape(T, -1),
+                acc.reshape(T, -1),
+                incl,
+                azim,
+                bend,
+                dist,
+            ],
             axis=1,
         )
 
@@ -507,4 +528,3 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         tags.input_tags.allow_nan = True
         tags.requires_fit = True
         return tags
-

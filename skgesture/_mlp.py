@@ -165,7 +165,8 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         n_classes = len(self.classes_)
         if n_classes < 2:
             raise ValueError(
-                f"TorchMLPClassifier needs at least 2 classes in y, got {n_classes}"
+                f"TorchMLPClassifier needs samples of at least 2 classes; y has "
+                f"{n_classes} class"
             )
         binary = n_classes == 2
         seed = seed_from(self.random_state)
@@ -233,6 +234,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         ndarray of shape (n_samples,)
             Predicted labels.
         """
+        check_is_fitted(self)
         return self.classes_[np.argmax(self.predict_proba(X), axis=1)]
 
     def __sklearn_tags__(self):

@@ -32,8 +32,17 @@ THRESHOLD_LONG_A = 0.6255
 MIN_CONSECUTIVE = 3
 
 
-def period_windows(W, start, end, steps, *, n_poses=N_POSES, stride=STRIDE,
-                   min_windows=MIN_WINDOWS, resize="bicubic"):
+def period_windows(
+    W,
+    start,
+    end,
+    steps,
+    *,
+    n_poses=N_POSES,
+    stride=STRIDE,
+    min_windows=MIN_WINDOWS,
+    resize="bicubic",
+):
     """Windows of one period ``[start, end)`` at the centres the paper uses.
 
     Centres run from ``start + h`` to ``end - 1 - h`` every ``stride`` frames, with
@@ -78,9 +87,17 @@ def period_windows(W, start, end, steps, *, n_poses=N_POSES, stride=STRIDE,
     return dynamic_poses(D, steps, n_poses, centres), centres, True
 
 
-def decide_period(scores, centres, length, *, short_length=SHORT_LENGTH,
-                  threshold_short=THRESHOLD_SHORT_A, threshold_long=THRESHOLD_LONG_A,
-                  min_consecutive=MIN_CONSECUTIVE, half_span=4):
+def decide_period(
+    scores,
+    centres,
+    length,
+    *,
+    short_length=SHORT_LENGTH,
+    threshold_short=THRESHOLD_SHORT_A,
+    threshold_long=THRESHOLD_LONG_A,
+    min_consecutive=MIN_CONSECUTIVE,
+    half_span=4,
+):
     """The paper's decision rule for one period of activity (METHOD_SPEC §5.5).
 
     * Short period (``length < short_length``): every window whose best score
@@ -344,13 +361,18 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
                 f"y has a single gesture class ({self.classes_[0]}); at least 2 "
                 f"are needed to train a classifier"
             )
-        rng = check_random_state(self.random_state) if self.random_state is not None else None
+        rng = (
+            check_random_state(self.random_state)
+            if self.random_state is not None
+            else None
+        )
         default = TorchMLPClassifier(
             hidden_layer_sizes=WINDOW_HIDDEN, activations=WINDOW_ACTIVATIONS
         )
         self.estimators_ = [
-            fit_inner_estimator(self.estimator, default, wins[:, k], labels, rng=rng,
-                                memory=self.memory)
+            fit_inner_estimator(
+                self.estimator, default, wins[:, k], labels, rng=rng, memory=self.memory
+            )
             for k in range(len(steps))
         ]
         return self
@@ -417,7 +439,9 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
                     f"weights has {w.size} values but steps has {len(steps)} scales"
                 )
             if np.any(w < 0) or w.sum() <= 0:
-                raise ValueError(f"weights must be non-negative and not all 0, got {self.weights}")
+                raise ValueError(
+                    f"weights must be non-negative and not all 0, got {self.weights}"
+                )
         return steps
 
     def _fusion_weights(self, n_scales):
@@ -435,7 +459,9 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             )
         F = W.shape[2] // self.n_poses
         if W.shape[2] != F * self.n_poses:
-            raise ValueError(f"window width {W.shape[2]} is not a multiple of n_poses={self.n_poses}")
+            raise ValueError(
+                f"window width {W.shape[2]} is not a multiple of n_poses={self.n_poses}"
+            )
         T = len(W)
         mid = (self.n_poses - 1) // 2
         for k, s in enumerate(steps):
@@ -453,8 +479,14 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
 
     def _windows(self, W, s, e, steps):
         return period_windows(
-            W, s, e, steps, n_poses=self.n_poses, stride=self.stride,
-            min_windows=self.min_windows, resize=self.resize,
+            W,
+            s,
+            e,
+            steps,
+            n_poses=self.n_poses,
+            stride=self.stride,
+            min_windows=self.min_windows,
+            resize=self.resize,
         )
 
     def _decide(self, X):
@@ -462,7 +494,8 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         steps = self._check_steps()
         masks = [
             np.ma.getmaskarray(x).reshape(len(x), -1).all(axis=1)
-            if isinstance(x, np.ma.MaskedArray) else None
+            if isinstance(x, np.ma.MaskedArray)
+            else None
             for x in X
         ]
         X = check_sequences(X, ndim=3, estimator=self, reset=False)
@@ -492,10 +525,14 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         pos = 0
         for i, s, e, centres, n in periods:
             lab, segs = decide_period(
-                scores[pos : pos + n], centres, e - s,
-                short_length=self.short_length, threshold_short=self.threshold_short,
+                scores[pos : pos + n],
+                centres,
+                e - s,
+                short_length=self.short_length,
+                threshold_short=self.threshold_short,
                 threshold_long=self.threshold_long,
-                min_consecutive=self.min_consecutive, half_span=half,
+                min_consecutive=self.min_consecutive,
+                half_span=half,
             )
             pos += n
             nz = lab > 0
@@ -503,9 +540,7 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             out[i][1].extend(
                 (self.classes_[c - 1], s + a, s + b, conf) for c, a, b, conf in segs
             )
-        return [
-            (lab, np.array(segs, dtype=float).reshape(-1, 4)) for lab, segs in out
-        ]
+        return [(lab, np.array(segs, dtype=float).reshape(-1, 4)) for lab, segs in out]
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -3,8 +3,8 @@
 :func:`build_net` makes the skorch net of any of the paper's MLPs. Estimators that
 own networks fit them through :func:`fit_cached`, which caches the fitted network
 with ``joblib.Memory`` keyed on the training data and the network's own
-parameters only, so decision parameters (thresholds, weights, smoothing, minimum lengths)
-can be searched by ``GridSearchCV`` without retraining (DESIGN.md §3).
+parameters only, so decision parameters (thresholds, weights, smoothing,
+minimum lengths) can be searched by ``GridSearchCV`` without retraining (DESIGN.md §3).
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -54,7 +54,9 @@ class MLPModule(nn.Module):
         Activation after each hidden layer (``"relu"``, ``"tanh"``, ...).
     """
 
-    def __init__(self, n_inputs, n_outputs, hidden_layer_sizes=(100,), activations=("tanh",)):
+    def __init__(
+        self, n_inputs, n_outputs, hidden_layer_sizes=(100,), activations=("tanh",)
+    ):
         super().__init__()
         if len(activations) != len(hidden_layer_sizes):
             raise ValueError(
@@ -182,7 +184,11 @@ class _MatlabStopping(Callback):
             self.fails_ = 0
         elif loss > self.best_loss_:
             self.fails_ += 1
-        stop = key == "valid_loss" and self.max_fail is not None and self.fails_ >= self.max_fail
+        stop = (
+            key == "valid_loss"
+            and self.max_fail is not None
+            and self.fails_ >= self.max_fail
+        )
         grad_norm = getattr(net.optimizer_, "grad_norm", None)
         if grad_norm is not None and grad_norm <= self.min_grad:
             stop = True
@@ -319,7 +325,9 @@ def predict_module(module, X, output):
     outs = []
     with torch.inference_mode():
         for start in range(0, len(X), PREDICT_BATCH):
-            xb = torch.as_tensor(_to_float32(X[start : start + PREDICT_BATCH]), device=device)
+            xb = torch.as_tensor(
+                _to_float32(X[start : start + PREDICT_BATCH]), device=device
+            )
             logits = module(xb)
             if output == "sigmoid":
                 prob = torch.sigmoid(logits)[:, 0]

@@ -197,7 +197,11 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
                 "y has no rest frame near any gesture (label 0): the segmenter "
                 "needs gesture and rest frames"
             )
-        rng = check_random_state(self.random_state) if self.random_state is not None else None
+        rng = (
+            check_random_state(self.random_state)
+            if self.random_state is not None
+            else None
+        )
         default = TorchMLPClassifier(
             hidden_layer_sizes=SEGMENTER_HIDDEN, activations=SEGMENTER_ACTIVATIONS
         )
@@ -274,7 +278,9 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         active = self.predict(X)
         X = check_sequences(X, ndim=2, estimator=self, reset=False)
         return [
-            np.ma.MaskedArray(x, mask=np.broadcast_to(~a.astype(bool)[:, None], x.shape))
+            np.ma.MaskedArray(
+                x, mask=np.broadcast_to(~a.astype(bool)[:, None], x.shape)
+            )
             for x, a in zip(X, active)
         ]
 

@@ -23,11 +23,17 @@ def check_steps(steps, n_poses):
     try:
         steps = tuple(int(s) for s in steps)
     except (TypeError, ValueError):
-        raise ValueError(f"steps must be a sequence of positive ints, got {steps!r}") from None
+        raise ValueError(
+            f"steps must be a sequence of positive ints, got {steps!r}"
+        ) from None
     if not steps or any(s < 1 for s in steps):
-        raise ValueError(f"steps must be a non-empty sequence of positive ints, got {steps!r}")
+        raise ValueError(
+            f"steps must be a non-empty sequence of positive ints, got {steps!r}"
+        )
     if n_poses % 2 != 1:
-        raise ValueError(f"n_poses must be odd (poses centred on a frame), got {n_poses}")
+        raise ValueError(
+            f"n_poses must be odd (poses centred on a frame), got {n_poses}"
+        )
     return steps
 
 
@@ -169,7 +175,9 @@ class DynamicPoseWindow(TransformerMixin, BaseEstimator):
             w = dynamic_poses(d, steps, self.n_poses)
             if isinstance(x, np.ma.MaskedArray):
                 rows = np.ma.getmaskarray(x).all(axis=1)
-                w = np.ma.MaskedArray(w, mask=np.broadcast_to(rows[:, None, None], w.shape))
+                w = np.ma.MaskedArray(
+                    w, mask=np.broadcast_to(rows[:, None, None], w.shape)
+                )
             out.append(w)
         return out
 

@@ -25,6 +25,20 @@ def shared_data():
 
 
 @pytest.fixture(autouse=True)
+def _one_torch_thread():
+    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
+    try:
+        import torch
+    except ImportError:  # pragma: no cover
+        yield
+        return
+    n_threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n_threads)
+
+
+@pytest.fixture(autouse=True)
 def _seed_everything():
     """Seed the global RNGs so a test that forgets random_state stays repeatable."""
     np.random.seed(0)  # noqa: NPY002 - test isolation only

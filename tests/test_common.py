@@ -7,7 +7,6 @@ stored unchanged, clone, get/set_params, fitted attributes, NotFittedError,
 reproducibility, pickling and parameter validation.
 """
 
-import importlib
 import pickle
 
 import joblib
@@ -119,7 +118,12 @@ OTHER_PARAMS = {
 
 
 def _make(name, **params):
-    return ESTIMATORS[name](**{**INIT_PARAMS[name], **params})
+    """A fresh instance with fast settings (inner estimators cloned, never shared)."""
+    params = {**INIT_PARAMS[name], **params}
+    params = {
+        k: clone(v) if isinstance(v, BaseEstimator) else v for k, v in params.items()
+    }
+    return ESTIMATORS[name](**params)
 
 
 # --------------------------------------------------------------------------------
@@ -201,15 +205,6 @@ def _assert_params_equal(p, q):
             assert value == other, key
 
 
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
-    n_threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n_threads)
-
-
 ALL = sorted(set(ESTIMATORS) & set(INIT_PARAMS))
 SEQ = sorted(set(ALL) & set(DATA))
 VALIDATED = sorted(set(ALL) & set(BAD_PARAMS))
@@ -230,29 +225,14 @@ def test_every_public_estimator_has_fast_settings_and_data():
     assert set(DATA) == set(ESTIMATORS) - {"TorchMLPClassifier"}
 
 
-def test_estimators_are_importable_from_their_modules():
-    for name, cls in ESTIMATORS.items():
-        module = importlib.import_module(cls.__module__)
-        assert getattr(module, name) is cls
-
-
 # --------------------------------------------------------------------------------
 # scikit-learn common checks on the 2-D network
 # --------------------------------------------------------------------------------
 
 EXPECTED_FAILED_CHECKS = {
     "TorchMLPClassifier": {
-        "check_estimators_unfitted": "BUG: predict reads classes_ before "
-        "check_is_fitted (AttributeError instead of NotFittedError); "
-        "see test_mlp.py::test_mlp_predict_before_fit_raises_not_fitted",
-        "check_fit_idempotent": "BUG: random_state does not seed the weight "
-        "initialisation (torch global RNG); see test_mlp.py",
-        "check_supervised_y_2d": "compares two fits: the random_state bug",
-        "check_classifier_data_not_an_array": "compares two fits: the random_state bug",
-        "check_fit2d_1sample": "the single-class error says 'got 1' where the "
-        "check looks for '1 class'",
-        "check_methods_subset_invariance": "float32 torch inference: with "
-        "several threads the result depends on the batch size (~3e-7)",
+        "check_methods_subset_invariance": "float32 torch inference may differ "
+        "by ~3e-7 with the batch size (seen with 2 intra-op threads)",
     },
 }
 

@@ -7,6 +7,7 @@ import pytest
 import torch
 from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.base import clone
+from sklearn.exceptions import NotFittedError
 
 from skgesture import TorchMLPClassifier
 from skgesture._networks import seed_from
@@ -37,15 +38,6 @@ THREE_CLASS = _blobs([(-3.0, 0.0), (3.0, 0.0), (0.0, 4.0)], labels=[1, 5, 9])
 
 def _clf(**params):
     return TorchMLPClassifier(**{**FAST, **params})
-
-
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
-    n_threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n_threads)
 
 
 @pytest.mark.parametrize("solver", SOLVERS)
@@ -204,7 +196,7 @@ def test_mlp_rejects_inconsistent_parameters(params, message):
 
 def test_mlp_rejects_a_single_class():
     X, _ = BINARY
-    with pytest.raises(ValueError, match="at least 2 classes"):
+    with pytest.raises(ValueError, match="at least 2 classes; y has 1 class"):
         _clf().fit(X, np.zeros(len(X), int))
 
 
@@ -215,13 +207,8 @@ def test_mlp_predict_checks_the_number_of_features():
         clf.predict(np.zeros((4, 3)))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: predict reads self.classes_ before predict_proba calls "
-    "check_is_fitted, so an unfitted classifier raises AttributeError",
-)
-def test_mlp_predict_before_fit_raises_not_fitted():
-    from sklearn.exceptions import NotFittedError
-
+@pytest.mark.parametrize("method", ["predict", "predict_proba", "score"])
+def test_mlp_unfitted_raises_not_fitted(method):
+    args = BINARY if method == "score" else BINARY[:1]
     with pytest.raises(NotFittedError):
-        _clf().predict(BINARY[0])
+        getattr(_clf(), method)(*args)

@@ -5,23 +5,12 @@ import copy
 import joblib
 import numpy as np
 import pytest
-import torch
 from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.linear_model import LogisticRegression
 
 from skgesture import DynamicPoseWindow, MultiScaleClassifier, TorchMLPClassifier
 from skgesture._multiscale import decide_period
 from skgesture.metrics import labels_to_segments
-
-
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
-    n_threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n_threads)
-
 
 # --------------------------------------------------------------------------------
 # decide_period on hand-made score sequences

@@ -57,15 +57,6 @@ def _small(pipe):
     )
 
 
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
-    n_threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n_threads)
-
-
 @pytest.fixture(scope="module")
 def streams():
     return make_gesture_streams(

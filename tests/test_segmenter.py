@@ -85,15 +85,6 @@ class _RecordingClassifier(LogisticRegression):
         return super().fit(X, y, sample_weight=sample_weight)
 
 
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    """Tiny networks train fastest on one thread (no oversubscription under xdist)."""
-    n_threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n_threads)
-
-
 @pytest.fixture(scope="module")
 def train():
     return _stream(TRAIN_LAYOUT, seed=0)
@@ -227,8 +218,8 @@ def test_segmenter_memory_reuses_the_network_across_decision_params(train, tmp_p
     # random_state=None: a retrained network would get a new seed, so identical
     # weights mean the cached network was reused
     unseeded = [ActivitySegmenter(_net()).fit([X], [y]) for _ in range(2)]
-    assert not torch.equal(_state(unseeded[0])["net.0.weight"],
-                           _state(unseeded[1])["net.0.weight"])  # fmt: skip
+    weights = [_state(seg)["net.0.weight"] for seg in unseeded]
+    assert not torch.equal(*weights)
     memory = joblib.Memory(tmp_path, verbose=0)
     first = ActivitySegmenter(_net(), memory=memory).fit([X], [y])
     assert _n_cached(tmp_path) == 1

@@ -219,9 +219,15 @@ class StreamingRecognizer:
         known (``a = 4`` descriptor frames, ``h = (span - 1) / 2`` smoothing
         frames; 11 with the paper's span 15).
     max_delay : int
-        Frames between the last frame of a gesture and its event, at most
-        (but see Notes for long periods): ``lookahead + 2`` for Methods A/B,
-        ``lookahead + window`` for Method C.
+        Frames between the last frame of a gesture and its event, at most,
+        once its period is known to be short or long (see Notes):
+        ``lookahead + 2 hw + stride`` for Methods A/B (21 with the paper's
+        numbers; ``hw`` is the half span of the widest window), ``lookahead +
+        window`` for Method C.
+    max_backfill : int
+        Untracked frames at the start of a stream that are replaced by copies
+        of the first tracked frame, as offline filling does (``2 span + 2a +
+        1``, 39 with span 15); earlier ones are rest.
     classes_ : ndarray
         Gesture classes of the wrapped classifier (rest excluded).
     n_frames_seen : int
@@ -240,12 +246,16 @@ class StreamingRecognizer:
     * a *short* period ``[s, e)`` (fewer than ``short_length`` frames) is
       decided with frame ``e + L`` (``e`` = first rest frame): the event is
       emitted ``L + 1`` frames after the gesture's last frame (12 with span 15);
-    * in a *long* period, each run of at least ``min_consecutive`` windows of
-      one class ``[lo, hi)`` is emitted as soon as a window that does not
-      continue it has been scored, with frame ``hi + 1 + L`` at the latest
-      (``L + 2`` frames after its last frame), but not before the period is
-      known to be long (frame ``s + short_length - 1 + L``): until then it
-      could still end short and be decided by majority vote;
+    * in a *long* period, a run of at least ``min_consecutive`` windows of one
+      class is emitted as soon as no later window can change its frames. A
+      frame goes to the run with the nearest window centre (decision D17) and
+      a run only claims frames within ``hw`` of its centres, so a run whose
+      last centre is ``c`` is final once the next window that could start a
+      qualifying run is centred at ``c + 2 hw`` or later: at most
+      ``L + 2 hw + stride`` frames (21) after the run's last frame, 17 when
+      rest follows. It is never emitted before the period is known to be long
+      (frame ``s + short_length - 1 + L``): until then the period could still
+      end short and be decided by majority vote;
     * Method C: a frame's probabilities are final when its 10-frame chunk is
       complete, so an event comes ``L + 1`` to ``L + window`` frames after the
       gesture's last frame.
@@ -258,8 +268,10 @@ class StreamingRecognizer:
     remaining differences: (1) untracked frames are held, not linearly
     interpolated, so windows over a dropout differ; (2) a frame whose torso is
     degenerate reuses the basis of the last good frame among the previous 8,
-    not of any earlier frame; (3) more than ``2 * span + 9`` untracked frames
-    at the start of a stream are rest, not copies of the first tracked frame.
+    not of any earlier frame; (3) of the untracked frames at the start of a
+    stream, only the last ``max_backfill`` become copies of the first tracked
+    frame (offline: all of them), so when that pose counts as active the
+    period starts later and its window grid may shift.
 
     **Memory.** Ring buffers of raw frames (``2a``), descriptors and scores
     (a few dozen rows), the window scores of the open period (at most
@@ -282,12 +294,12 @@ class StreamingRecognizer:
     >>> pipe = pipe.fit(data.X[:3], data.y[:3])
     >>> rec = StreamingRecognizer(pipe)
     >>> rec.lookahead, rec.max_delay
-    (11, 13)
+    (11, 21)
     >>> events = []
     >>> for frame in data.X[3]:
     ...     events += rec.push(frame)
     >>> events += rec.flush()
-    >>> all(0 <= ev.delay <= 13 + 55 for ev in events)
+    >>> all(0 <= ev.delay <= rec.max_delay + 55 for ev in events)
     True
     """
 
@@ -480,7 +492,7 @@ class StreamingRecognizer:
         gauss_reach = (GAUSSIAN_SIZE - 1) // 2 if desc.sigma > 0 else 0
         self._reach = gauss_reach + DERIVATIVE_REACH  # a
         # Leading untracked frames copied from the first tracked one.
-        self._max_backfill = 0
+        self.max_backfill = 0
         rest = stages[1:]
         kinds = [type(est).__name__ for est in rest]
         if kinds == ["BiLSTMTagger"]:
@@ -499,7 +511,7 @@ class StreamingRecognizer:
                 "DynamicPoseWindow -> MultiScaleClassifier (Methods A/B) or "
                 f"PoseDescriptor -> BiLSTMTagger (Method C), got {kinds}"
             )
-        self._max_backfill = 2 * self._span + 2 * self._reach + 1
+        self.max_backfill = 2 * self._span + 2 * self._reach + 1
         if self.target_names is not None and len(self.target_names) < max(self.classes_):
             raise ValueError(
                 f"target_names has {len(self.target_names)} names but the classes go "
@@ -553,7 +565,9 @@ class StreamingRecognizer:
         self._desc_capacity = BLOCK + self._h + need + RING_MARGIN
         self._score_capacity = BLOCK + 2 * self._span + 2 * self._reach + RING_MARGIN
         self.lookahead = self._reach + self._h
-        self.max_delay = self.lookahead + self._stride
+        # A run is final once no window within 2 hw of its end can still join a
+        # qualifying run (see _scan_runs); short periods need only L + 1.
+        self.max_delay = self.lookahead + 2 * self._half + self._stride
 
     def _inspect_tagger(self, tagger):
         from skgesture._bilstm import _chunks
@@ -606,7 +620,7 @@ class StreamingRecognizer:
             frames, missing = frames[k:], missing[k:]
             # Offline fill copies the first tracked frame backwards; copy up to
             # _max_backfill of the leading untracked frames, older ones are rest.
-            n_copies = min(self._n_leading, self._max_backfill)
+            n_copies = min(self._n_leading, self.max_backfill)
             self._origin = self._n_leading - n_copies
             self._floor = first_index + k
             frames = np.concatenate([np.repeat(frames[:1], n_copies, axis=0), frames])

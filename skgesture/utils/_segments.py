@@ -97,7 +97,9 @@ def segments_to_labels(segments, n_frames, *, on_overlap="raise"):
     [0, 3, 3, 0, 5, 5, 5, 0]
     """
     if on_overlap not in ("raise", "warn", "later"):
-        raise ValueError(f"on_overlap must be 'raise', 'warn' or 'later', got {on_overlap!r}")
+        raise ValueError(
+            f"on_overlap must be 'raise', 'warn' or 'later', got {on_overlap!r}"
+        )
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 3)
     y = np.zeros(int(n_frames), dtype=np.int64)
     claimed = np.zeros(int(n_frames), dtype=bool)

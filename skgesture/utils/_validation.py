@@ -97,13 +97,15 @@ def check_sequences(
                 f"at least 2 dimensions"
             )
         if ndim is not None and arr.ndim != ndim:
-            expect = "(n_frames, " + ", ".join(
-                str(s) if s is not None else "?"
-                for s in (frame_shape or (None,) * (ndim - 1))
-            ) + ")"
-            raise ValueError(
-                f"{name}[{i}] has shape {arr.shape}; expected {expect}"
+            expect = (
+                "(n_frames, "
+                + ", ".join(
+                    str(s) if s is not None else "?"
+                    for s in (frame_shape or (None,) * (ndim - 1))
+                )
+                + ")"
             )
+            raise ValueError(f"{name}[{i}] has shape {arr.shape}; expected {expect}")
         if frame_shape is not None:
             fs = tuple(frame_shape)
             ok = len(fs) == arr.ndim - 1 and all(
@@ -131,7 +133,9 @@ def check_sequences(
                     f"{frame}); fill untracked frames first (PoseDescriptor does)"
                 )
         elif np.isinf(arr).any():
-            frame = int(np.flatnonzero(np.isinf(arr.reshape(arr.shape[0], -1)).any(1))[0])
+            frame = int(
+                np.flatnonzero(np.isinf(arr.reshape(arr.shape[0], -1)).any(1))[0]
+            )
             raise ValueError(f"{name}[{i}] contains infinite values (frame {frame})")
         out.append(np.ascontiguousarray(arr))
     if estimator is not None and reset:
@@ -189,13 +193,13 @@ def check_sequence_labels(y, X=None, *, n_classes=None, name="y"):
     for i, lab in enumerate(y):
         arr = np.asarray(lab)
         if arr.ndim != 1:
-            raise ValueError(
-                f"{name}[{i}] has shape {arr.shape}; expected (n_frames,)"
-            )
+            raise ValueError(f"{name}[{i}] has shape {arr.shape}; expected (n_frames,)")
         if arr.size and not np.issubdtype(arr.dtype, np.integer):
-            if not np.issubdtype(arr.dtype, np.number) or not np.all(
-                np.isfinite(arr)
-            ) or np.any(arr != np.round(arr)):
+            if (
+                not np.issubdtype(arr.dtype, np.number)
+                or not np.all(np.isfinite(arr))
+                or np.any(arr != np.round(arr))
+            ):
                 raise ValueError(
                     f"{name}[{i}] must hold integer class labels (0 = rest), got "
                     f"dtype {arr.dtype}"
@@ -203,8 +207,7 @@ def check_sequence_labels(y, X=None, *, n_classes=None, name="y"):
         arr = arr.astype(np.int64)
         if X is not None and len(arr) != len(X[i]):
             raise ValueError(
-                f"{name}[{i}] has {len(arr)} labels but X[{i}] has {len(X[i])} "
-                f"frames"
+                f"{name}[{i}] has {len(arr)} labels but X[{i}] has {len(X[i])} frames"
             )
         if arr.size and arr.min() < 0:
             frame = int(np.argmax(arr < 0))

@@ -1,0 +1,164 @@
+"""Action map, pick-and-place robot and the commander wiring them to events."""
+
+import pytest
+
+from skgesture.streaming import (
+    ActionMap,
+    GestureCommander,
+    GestureEvent,
+    PickAndPlaceRobot,
+    RobotCommand,
+    RobotState,
+    SimulatedRobot,
+)
+
+CYCLE = [
+    ("move_to_tool", "at_tool"),
+    ("close_gripper", "holding"),
+    ("carry_tool", "carried"),
+    ("open_gripper", "released"),
+    ("return_home", "home"),
+]
+
+
+def _event(label, emitted_at, confidence=0.9):
+    return GestureEvent(label=label, start=emitted_at - 40, end=emitted_at - 12,
+                        confidence=confidence, emitted_at=emitted_at)
+
+
+def test_full_cycle_is_accepted_in_order():
+    robot = SimulatedRobot()
+    for command, state in CYCLE * 2:
+        result = robot.execute(command, frame=7)
+        assert result.accepted and result.reason == "ok" and result.frame == 7
+        assert robot.state == RobotState(state) == result.state_after
+    assert robot.actions == [RobotCommand(c) for c, _ in CYCLE] * 2
+    assert robot.status() == {
+        "state": "home", "next_command": "move_to_tool", "gripper": "open",
+        "holding": False, "n_accepted": 10, "n_refused": 0,
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "prefix, command, reason",
+    [
+        (0, "open_gripper", "the gripper holds nothing"),
+        (0, "carry_tool", "no tool is held"),
+        (0, "return_home", "already home"),
+        (0, "close_gripper", "the gripper is not at the tool"),
+        (1, "move_to_tool", "already at the tool"),
+        (1, "open_gripper", "the gripper holds nothing"),
+        (2, "open_gripper", "the tool has not been carried to its target yet"),
+        (2, "close_gripper", "the gripper is already closed"),
+        (2, "return_home", "a tool is held: carry_tool comes next"),
+        (3, "move_to_tool", "a tool is held: open_gripper comes next"),
+        (4, "open_gripper", "the gripper is already open"),
+        (4, "move_to_tool", "out of order: return_home comes next in state released"),
+    ],
+)
+def test_out_of_order_commands_are_refused_and_logged(prefix, command, reason):
+    robot = SimulatedRobot()
+    for c, _ in CYCLE[:prefix]:
+        robot.execute(c)
+    before = robot.state
+    result = robot.execute(command)
+    assert not result.accepted
+    assert result.reason == reason
+    assert robot.state is before is result.state_before is result.state_after
+    assert robot.log[-1] is result
+    assert robot.status()["n_refused"] == 1
+    assert len(robot.actions) == prefix  # nothing was done
+
+
+def test_unknown_command_raises():
+    with pytest.raises(ValueError):
+        SimulatedRobot().execute("dance")
+
+
+def test_a_real_robot_plugs_in_through_perform():
+    class FlakyGripper(PickAndPlaceRobot):
+        def __init__(self):
+            super().__init__()
+            self.calls = []
+
+        def _perform(self, command):
+            self.calls.append(command)
+            if command is RobotCommand.CLOSE_GRIPPER:
+                raise RuntimeError("gripper jammed")
+
+    robot = FlakyGripper()
+    assert robot.execute("move_to_tool").accepted
+    result = robot.execute("close_gripper")
+    assert not result.accepted and result.reason == "robot error: gripper jammed"
+    assert robot.state is RobotState.AT_TOOL and not robot.holding
+    assert robot.calls == [RobotCommand.MOVE_TO_TOOL, RobotCommand.CLOSE_GRIPPER]
+
+
+def test_action_map_confidence_floor_refractory_and_unmapped():
+    amap = ActionMap({1: "move_to_tool", 2: RobotCommand.CLOSE_GRIPPER, 3: "beep"},
+                     min_confidence=0.6, refractory_frames=30)
+    assert amap.mapping[1] is RobotCommand.MOVE_TO_TOOL
+    assert amap.mapping[3] == "beep"  # any command for other programs
+    low = amap.decide(_event(1, 100, confidence=0.5))
+    assert not low.issued and low.reason == "confidence 0.50 < 0.6"
+    first = amap.decide(_event(1, 110))
+    assert first.issued and first.command is RobotCommand.MOVE_TO_TOOL
+    # A second event from the same gesture (or too soon after it) is ignored.
+    echo = amap.decide(_event(2, 139))
+    assert not echo.issued
+    assert echo.reason == "refractory: 29 frames after the last command (< 30)"
+    assert amap(_event(2, 140)).command is RobotCommand.CLOSE_GRIPPER
+    unmapped = amap.decide(_event(9, 400))
+    assert not unmapped.issued and unmapped.reason == "class 9 has no command"
+    amap.reset()
+    assert amap.decide(_event(1, 141)).issued
+    with pytest.raises(ValueError, match="min_confidence"):
+        ActionMap({}, min_confidence=2)
+    with pytest.raises(ValueError, match="refractory_frames"):
+        ActionMap({}, refractory_frames=-1)
+
+
+class _ScriptedRecognizer:
+    """Returns prepared events at given frames (a stand-in for the recogniser)."""
+
+    def __init__(self, events):
+        self.events = events
+        self.t = -1
+
+    def push(self, frame):
+        self.t += 1
+        return [ev for ev in self.events if ev.emitted_at == self.t]
+
+    def flush(self):
+        return [ev for ev in self.events if ev.emitted_at > self.t]
+
+
+def test_commander_drives_the_robot_from_events():
+    events = [
+        _event(1, 50),  # move_to_tool
+        _event(3, 60),  # open_gripper: refused, holds nothing (refractory 0)
+        _event(2, 100),  # close_gripper
+        _event(2, 105, confidence=0.3),  # below the floor
+        _event(4, 150),  # carry_tool
+        _event(3, 200),  # open_gripper
+        _event(5, 260),  # return_home, decided at flush
+    ]
+    amap = ActionMap({1: "move_to_tool", 2: "close_gripper", 4: "carry_tool",
+                      3: "open_gripper", 5: "return_home"}, min_confidence=0.5)
+    robot = SimulatedRobot()
+    commander = GestureCommander(_ScriptedRecognizer(events), amap, robot)
+    log = commander.run([None] * 240)
+    assert len(log) == len(events)
+    issued = [(d.event.emitted_at, str(d.command), r.accepted, r.reason)
+              for d, r in log if d.issued]
+    assert issued == [
+        (50, "move_to_tool", True, "ok"),
+        (60, "open_gripper", False, "the gripper holds nothing"),
+        (100, "close_gripper", True, "ok"),
+        (150, "carry_tool", True, "ok"),
+        (200, "open_gripper", True, "ok"),
+        (260, "return_home", True, "ok"),
+    ]
+    ignored = [d.reason for d, r in log if not d.issued]
+    assert ignored == ["confidence 0.30 < 0.5"] and robot.state is RobotState.HOME
+    assert [r.frame for r in robot.log] == [50, 60, 100, 150, 200, 260]
