@@ -32,6 +32,21 @@ THRESHOLD_LONG_A = 0.6255
 MIN_CONSECUTIVE = 3
 
 
+def _row_mask(x):
+    """Per-row rest mask of a masked sequence, or None for a plain array."""
+    mask = np.ma.getmask(x)
+    if mask is np.ma.nomask:
+        return None if not isinstance(x, np.ma.MaskedArray) else np.zeros(len(x), bool)
+    return mask.reshape(len(x), -1)[:, 0].copy()
+
+
+def default_window_network():
+    """The paper's window network: 300 (tanh) - 100 (tanh) - K (softmax)."""
+    return TorchMLPClassifier(
+        hidden_layer_sizes=WINDOW_HIDDEN, activations=WINDOW_ACTIVATIONS
+    )
+
+
 def period_windows(
     W,
     start,
@@ -339,7 +354,7 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             The fitted classifier.
         """
         steps = self._check_steps()
-        X = check_sequences(X, ndim=3, estimator=self, reset=True)
+        X = check_sequences(X, ndim=3, estimator=self, reset=True, dtype=np.float32)
         self._check_layout(X[0], steps)
         y = check_sequence_labels(y, X)
         wins, labels = [], []
@@ -366,9 +381,7 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             if self.random_state is not None
             else None
         )
-        default = TorchMLPClassifier(
-            hidden_layer_sizes=WINDOW_HIDDEN, activations=WINDOW_ACTIVATIONS
-        )
+        default = default_window_network()
         self.estimators_ = [
             fit_inner_estimator(
                 self.estimator, default, wins[:, k], labels, rng=rng, memory=self.memory
@@ -492,13 +505,9 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     def _decide(self, X):
         check_is_fitted(self)
         steps = self._check_steps()
-        masks = [
-            np.ma.getmaskarray(x).reshape(len(x), -1).all(axis=1)
-            if isinstance(x, np.ma.MaskedArray)
-            else None
-            for x in X
-        ]
-        X = check_sequences(X, ndim=3, estimator=self, reset=False)
+        # A row is rest when it is masked (the first value of a row decides).
+        masks = [_row_mask(x) for x in X]
+        X = check_sequences(X, ndim=3, estimator=self, reset=False, dtype=np.float32)
         # Gather the windows of every period of every sequence, score them in
         # one call per scale, then apply the decision rules period by period.
         periods, wins = [], []

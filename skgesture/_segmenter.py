@@ -27,6 +27,13 @@ MIN_LENGTH = 12
 SMOOTH_SPAN = 15  # decision D12
 
 
+def default_frame_network():
+    """The paper's segmentation network: 100 (ReLU) - 100 (tanh) - 1 (sigmoid)."""
+    return TorchMLPClassifier(
+        hidden_layer_sizes=SEGMENTER_HIDDEN, activations=SEGMENTER_ACTIVATIONS
+    )
+
+
 def context_mask(y, n_context):
     """Training frames of the segmenter in one sequence (METHOD_SPEC §4.1).
 
@@ -202,9 +209,7 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
             if self.random_state is not None
             else None
         )
-        default = TorchMLPClassifier(
-            hidden_layer_sizes=SEGMENTER_HIDDEN, activations=SEGMENTER_ACTIVATIONS
-        )
+        default = default_frame_network()
         self.estimator_ = fit_inner_estimator(
             self.estimator, default, Xf, yf, rng=rng, memory=self.memory
         )
