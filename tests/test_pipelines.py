@@ -105,7 +105,14 @@ def test_method_a_has_the_papers_stages_and_numbers():
     assert tuple(clf.steps) == STEPS_A
     assert (clf.threshold_short, clf.threshold_long) == THRESHOLDS_A
     assert clf.weights is None
-    assert clf.estimator is None  # the paper's 300-100 network
+    # The paper's 549-300 (tanh)-100 (tanh)-K network, explicit so that nested
+    # parameters (classifier__estimator__max_epochs) can be set.
+    assert isinstance(clf.estimator, TorchMLPClassifier)
+    assert tuple(clf.estimator.hidden_layer_sizes) == (300, 100)
+    assert tuple(clf.estimator.activations) == ("tanh", "tanh")
+    seg = pipe.named_steps["segmenter"].estimator
+    assert tuple(seg.hidden_layer_sizes) == (100, 100)
+    assert tuple(seg.activations) == ("relu", "tanh")
     seg = pipe.named_steps["segmenter"]
     assert {k: seg.get_params()[k] for k in SEGMENTER_DEFAULTS} == SEGMENTER_DEFAULTS
     assert pipe.named_steps["descriptor"].joints == "paper11"
