@@ -2,6 +2,7 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from contextlib import contextmanager
 from numbers import Integral, Real
 
 import numpy as np
@@ -121,6 +122,20 @@ def _training_windows(X, y, window, rest_step, gesture_step):
         yw.append(ys)
         seq.append(np.full(len(xs), i, dtype=np.int64))
     return np.concatenate(Xw), np.concatenate(yw), np.concatenate(seq)
+
+
+@contextmanager
+def _torch_threads(n_threads):
+    """Run the block with ``n_threads`` torch intra-op threads (``None``: as is)."""
+    if n_threads is None:
+        yield
+        return
+    before = torch.get_num_threads()
+    torch.set_num_threads(n_threads)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def _chunks(n_frames, window, overlap):
@@ -264,6 +279,10 @@ class _SequenceHoldout:
         )
 
 
+def _silent(*args, **kwargs):
+    """A skorch ``sink`` that prints nothing."""
+
+
 class _BiLSTMNet(BaseEstimator):
     """The trainable part of :class:`BiLSTMTagger`, cached by ``fit_cached``.
 
@@ -371,10 +390,6 @@ class _BiLSTMNet(BaseEstimator):
         return self
 
 
-def _silent(*args, **kwargs):
-    """A skorch ``sink`` that prints nothing."""
-
-
 class BiLSTMTagger(ClassifierMixin, BaseEstimator):
     """Bidirectional LSTM labelling every frame of a stream (Method C).
 
@@ -450,9 +465,15 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
     device : str, default="cpu"
         Torch device of the training (``"cuda"`` for :meth:`paper`). A fitted
         tagger loads and predicts on a machine without CUDA.
+    n_threads : int or None, default=1
+        Torch intra-op CPU threads while fitting and predicting (the previous
+        setting is restored afterwards); ``None`` keeps torch's setting. One
+        thread is fastest for the small default network and immune to
+        oversubscription (see Notes); raise it for large networks on a CPU.
     random_state : int, RandomState instance or None, default=None
         Seeds the initialisation, the dropout, the window shuffling and the
-        validation split.
+        validation split; an int gives identical results on the CPU for a given
+        ``n_threads`` (the thread count changes the floating-point sums).
     verbose : int, default=0
         0 is silent; 1 or more prints one line per epoch.
 
@@ -488,9 +509,12 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
     zero frames on the right, the padding being left out of the loss (MATLAB
     pads on the right too); prediction takes sequences of any length >= 1.
 
-    Cost of the CPU default: fitting on the 48 PRECOG sequences (12,269 frames,
-    9 classes, 183-D descriptors, 4,1xx windows) takes about XX s on 2 CPU
-    cores (torch 2.13), measured with::
+    Cost of the CPU default: fitting ``make_method_c(random_state=0)`` on the 48
+    bundled PRECOG sequences (12,269 frames, 9 classes, 183-D descriptors, 5,402
+    training windows, 40 epochs) took 40-53 s on a 2-core CPU shared with other
+    jobs (load 3-5; torch 2.13), predicting them 0.2-0.3 s. The same fit with
+    two torch threads (``n_threads=None``) took 696 s on that busy machine:
+    for this network size one thread is the better default. Reproduce with::
 
         python -c "import time; from skgesture import make_method_c; \\
         from skgesture.datasets import load_precog; d = load_precog(); \\
@@ -541,6 +565,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         "overlap": ["boolean"],
         "memory": [None, str, HasMethods(["cache"])],
         "device": [str],
+        "n_threads": [Interval(Integral, 1, None, closed="left"), None],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
@@ -569,6 +594,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         overlap=False,
         memory=None,
         device="cpu",
+        n_threads=1,
         random_state=None,
         verbose=0,
     ):
@@ -593,6 +619,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         self.overlap = overlap
         self.memory = memory
         self.device = device
+        self.n_threads = n_threads
         self.random_state = random_state
         self.verbose = verbose
 
@@ -690,7 +717,8 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
             random_state=random_state,
             verbose=self.verbose,
         )
-        fitted = fit_cached(self.memory, network, X, y_idx)
+        with _torch_threads(self.n_threads):
+            fitted = fit_cached(self.memory, network, X, y_idx)
         self.classes_ = classes
         self.net_ = fitted.net_
         self.n_windows_ = fitted.n_windows_
@@ -711,9 +739,10 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = check_sequences(X, ndim=2, estimator=self, reset=False)
-        return _predict_chunks(
-            self.net_.module_, X, self.window, self.overlap, len(self.classes_)
-        )
+        with _torch_threads(self.n_threads):
+            return _predict_chunks(
+                self.net_.module_, X, self.window, self.overlap, len(self.classes_)
+            )
 
     def decision_function(self, X):
         """Loess-smoothed per-frame class probabilities.

@@ -6,8 +6,8 @@ from sklearn.pipeline import Pipeline
 
 from skgesture._bilstm import BiLSTMTagger
 from skgesture._descriptor import PoseDescriptor
-from skgesture._multiscale import MultiScaleClassifier
-from skgesture._segmenter import ActivitySegmenter
+from skgesture._multiscale import MultiScaleClassifier, default_window_network
+from skgesture._segmenter import ActivitySegmenter, default_frame_network
 from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
 
 __all__ = ["make_method_a", "make_method_b", "make_method_c"]
@@ -35,25 +35,42 @@ _DOC_COMMON = """
 """
 
 
-def _multiscale_pipeline(steps, classifier_kwargs, *, joints, segment, memory,
-                         random_state, verbose):
+def _multiscale_pipeline(
+    steps, classifier_kwargs, *, joints, segment, memory, random_state, verbose
+):
     stages = [("descriptor", PoseDescriptor(joints=joints))]
     if segment:
         stages.append(
-            ("segmenter", ActivitySegmenter(memory=memory, random_state=random_state,
-                                            verbose=verbose))
+            (
+                "segmenter",
+                ActivitySegmenter(
+                    default_frame_network(),
+                    memory=memory,
+                    random_state=random_state,
+                    verbose=verbose,
+                ),
+            )
         )
     stages += [
         ("windows", DynamicPoseWindow(steps=steps)),
-        ("classifier", MultiScaleClassifier(steps=steps, memory=memory,
-                                            random_state=random_state, verbose=verbose,
-                                            **classifier_kwargs)),
+        (
+            "classifier",
+            MultiScaleClassifier(
+                default_window_network(),
+                steps=steps,
+                memory=memory,
+                random_state=random_state,
+                verbose=verbose,
+                **classifier_kwargs,
+            ),
+        ),
     ]
     return Pipeline(stages)
 
 
-def make_method_a(*, joints="paper11", segment=True, memory=None, random_state=None,
-                  verbose=0):
+def make_method_a(
+    *, joints="paper11", segment=True, memory=None, random_state=None, verbose=0
+):
     """Method A: descriptor, segmenter, single-scale dynamic-pose classifier.
 
     PoseDescriptor -> ActivitySegmenter -> DynamicPoseWindow(steps=(4,)) ->
@@ -72,13 +89,19 @@ def make_method_a(*, joints="paper11", segment=True, memory=None, random_state=N
     ['descriptor', 'segmenter', 'windows', 'classifier']
     """
     return _multiscale_pipeline(
-        STEPS_A, {}, joints=joints, segment=segment, memory=memory,
-        random_state=random_state, verbose=verbose,
+        STEPS_A,
+        {},
+        joints=joints,
+        segment=segment,
+        memory=memory,
+        random_state=random_state,
+        verbose=verbose,
     )
 
 
-def make_method_b(*, joints="paper11", segment=True, memory=None, random_state=None,
-                  verbose=0):
+def make_method_b(
+    *, joints="paper11", segment=True, memory=None, random_state=None, verbose=0
+):
     """Method B: three time scales (steps 4, 3, 2) with fused scores.
 
     As :func:`make_method_a` with ``steps=(4, 3, 2)``, fusion weights
@@ -101,8 +124,13 @@ def make_method_b(*, joints="paper11", segment=True, memory=None, random_state=N
         "threshold_long": THRESHOLD_LONG_B,
     }
     return _multiscale_pipeline(
-        STEPS_B, kwargs, joints=joints, segment=segment, memory=memory,
-        random_state=random_state, verbose=verbose,
+        STEPS_B,
+        kwargs,
+        joints=joints,
+        segment=segment,
+        memory=memory,
+        random_state=random_state,
+        verbose=verbose,
     )
 
 
@@ -110,8 +138,15 @@ make_method_a.__doc__ = make_method_a.__doc__.format(common=_DOC_COMMON)
 make_method_b.__doc__ = make_method_b.__doc__.format(common=_DOC_COMMON)
 
 
-def make_method_c(*, joints="paper11", memory=None, random_state=None, verbose=0,
-                  paper=False, device="cpu"):
+def make_method_c(
+    *,
+    joints="paper11",
+    memory=None,
+    random_state=None,
+    verbose=0,
+    paper=False,
+    device="cpu",
+):
     """Method C: descriptor and bidirectional LSTM tagger, no segmentation stage.
 
     PoseDescriptor -> BiLSTMTagger: every frame gets one of K + 1 classes,
@@ -148,7 +183,11 @@ def make_method_c(*, joints="paper11", memory=None, random_state=None, verbose=0
     >>> [name for name, _ in pipe.steps], pipe.named_steps["tagger"].hidden_sizes
     (['descriptor', 'tagger'], (1024, 1024, 512))
     """
-    params = {"memory": memory, "random_state": random_state, "verbose": verbose,
-              "device": device}
+    params = {
+        "memory": memory,
+        "random_state": random_state,
+        "verbose": verbose,
+        "device": device,
+    }
     tagger = BiLSTMTagger.paper(**params) if paper else BiLSTMTagger(**params)
     return Pipeline([("descriptor", PoseDescriptor(joints=joints)), ("tagger", tagger)])

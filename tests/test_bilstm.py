@@ -374,6 +374,24 @@ def test_memory_caches_network_across_decision_params(toy, tmp_path, monkeypatch
     assert len(calls) == 2
 
 
+def test_n_threads_applies_during_fit_and_is_restored(toy, monkeypatch):
+    seen = []
+    original = _BiLSTMNet.fit
+
+    def spying_fit(self, X, y):
+        seen.append(torch.get_num_threads())
+        return original(self, X, y)
+
+    monkeypatch.setattr(_BiLSTMNet, "fit", spying_fit)
+    X, y = toy[0][:2], toy[1][:2]
+    torch.set_num_threads(2)
+    BiLSTMTagger(**{**TINY, "max_epochs": 1}).fit(X, y)
+    assert seen == [1] and torch.get_num_threads() == 2
+    torch.set_num_threads(1)
+    BiLSTMTagger(**{**TINY, "max_epochs": 1}, n_threads=None).fit(X, y)
+    assert seen == [1, 1]
+
+
 def test_verbose_prints_epochs_only_when_asked(toy, capsys):
     X, y = toy[0][:2], toy[1][:2]
     BiLSTMTagger(**{**TINY, "max_epochs": 2}).fit(X, y)
