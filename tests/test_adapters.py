@@ -62,7 +62,9 @@ def assert_anatomy(sequences, *, facing=0.9, max_cv=0.35):
     facing the camera, plausible and nearly constant bone lengths."""
     X = np.concatenate([_tracked(x) for x in sequences])
     y = X[..., 1]
-    torso = [J(n) for n in ("ShoulderCenter", "ShoulderLeft", "ShoulderRight", "HipCenter")]
+    torso = [
+        J(n) for n in ("ShoulderCenter", "ShoulderLeft", "ShoulderRight", "HipCenter")
+    ]
     assert np.mean(y[:, J("Head")] > y[:, torso].max(axis=1)) > 0.95
     feet = [J(n) for n in ("FootLeft", "FootRight", "AnkleLeft", "AnkleRight")]
     assert np.mean(np.isin(np.argmin(y, axis=1), feet)) > 0.95
@@ -118,8 +120,10 @@ def test_msr_adapter_reorders_real_files_like_the_loader(msr, shared_data):
 def test_msr_adapted_skeletons_are_anatomical(msr, shared_data):
     folder = shared_data / "msr_action3d" / "real_world_coordinates"
     clips = msr.sample_ids[::5]
-    adapted = [MSRAction3DAdapter()(_read_msr_file(folder / f"{c}_skeleton3D.txt"))
-               for c in clips]
+    adapted = [
+        MSRAction3DAdapter()(_read_msr_file(folder / f"{c}_skeleton3D.txt"))
+        for c in clips
+    ]
     assert_anatomy(adapted, max_cv=0.2)
     assert_descriptor_finite(adapted[:20])
 
@@ -172,10 +176,21 @@ def _as_azure_kinect(X):
     }  # fmt: skip
     for side in ("LEFT", "RIGHT"):
         s = side.title()
-        for part in ("Shoulder", "Elbow", "Wrist", "Hand", "Hip", "Knee", "Ankle", "Foot"):
+        for part in (
+            "Shoulder",
+            "Elbow",
+            "Wrist",
+            "Hand",
+            "Hip",
+            "Knee",
+            "Ankle",
+            "Foot",
+        ):
             joints[f"{part.upper()}_{side}"] = v1[f"{part}{s}"]
         joints[f"CLAVICLE_{side}"] = (v1["ShoulderCenter"] + v1[f"Shoulder{s}"]) / 2
-        joints[f"HANDTIP_{side}"] = v1[f"Hand{s}"] + 0.8 * (v1[f"Hand{s}"] - v1[f"Wrist{s}"])
+        joints[f"HANDTIP_{side}"] = v1[f"Hand{s}"] + 0.8 * (
+            v1[f"Hand{s}"] - v1[f"Wrist{s}"]
+        )
         joints[f"THUMB_{side}"] = v1[f"Hand{s}"] + [0.0, 0.03, 0.0]
         joints[f"EYE_{side}"] = v1["Head"] + [0.0, 0.03, -0.08]
         joints[f"EAR_{side}"] = v1["Head"]
@@ -224,8 +239,9 @@ def test_kinect_v2_adapter_on_real_skeletons(utk):
 
 def test_azure_kinect_adapter_on_real_skeletons(utk):
     for x in utk.X[:6]:
-        np.testing.assert_allclose(AzureKinectAdapter()(_as_azure_kinect(x)), x,
-                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            AzureKinectAdapter()(_as_azure_kinect(x)), x, rtol=0, atol=1e-12
+        )
     adapted = [AzureKinectAdapter()(_as_azure_kinect(x)) for x in utk.X]
     assert_anatomy(adapted)
     assert_descriptor_finite(adapted[:4])
@@ -251,7 +267,8 @@ def test_mediapipe_adapter_on_real_skeletons(utk):
         # Spine is interpolated at the measured Kinect v1 position.
         np.testing.assert_allclose(
             a[:, J("Spine")],
-            a[:, J("HipCenter")] + 0.165 * (a[:, J("ShoulderCenter")] - a[:, J("HipCenter")]),
+            a[:, J("HipCenter")]
+            + 0.165 * (a[:, J("ShoulderCenter")] - a[:, J("HipCenter")]),
         )
 
 
@@ -307,8 +324,9 @@ def test_adapter_errors_and_lookup():
         MediaPipePoseAdapter(aspect_ratio=0)
     with pytest.raises(ValueError, match="unknown layout"):
         get_adapter("openpose")
-    assert isinstance(get_adapter("mediapipe_pose", aspect_ratio=16 / 9),
-                      MediaPipePoseAdapter)
+    assert isinstance(
+        get_adapter("mediapipe_pose", aspect_ratio=16 / 9), MediaPipePoseAdapter
+    )
     assert get_adapter("mediapipe_pose", aspect_ratio=16 / 9).aspect_ratio == 16 / 9
     assert {get_adapter(n).n_joints for n in ("kinect_v2", "azure_kinect")} == {25, 32}
 
@@ -322,8 +340,14 @@ def test_replay_source_adapts_and_paces_frames(utk):
         waits.append(seconds)
         now[0] += seconds
 
-    source = ReplaySource(_as_azure_kinect(x), adapter="azure_kinect", fps=20,
-                          realtime=True, clock=lambda: now[0], sleep=sleep)
+    source = ReplaySource(
+        _as_azure_kinect(x),
+        adapter="azure_kinect",
+        fps=20,
+        realtime=True,
+        clock=lambda: now[0],
+        sleep=sleep,
+    )
     assert isinstance(source, SkeletonSource)
     frames = list(source)
     np.testing.assert_allclose(np.stack(frames), x, atol=1e-12)

@@ -22,8 +22,13 @@ CYCLE = [
 
 
 def _event(label, emitted_at, confidence=0.9):
-    return GestureEvent(label=label, start=emitted_at - 40, end=emitted_at - 12,
-                        confidence=confidence, emitted_at=emitted_at)
+    return GestureEvent(
+        label=label,
+        start=emitted_at - 40,
+        end=emitted_at - 12,
+        confidence=confidence,
+        emitted_at=emitted_at,
+    )
 
 
 def test_full_cycle_is_accepted_in_order():
@@ -95,8 +100,11 @@ def test_a_real_robot_plugs_in_through_perform():
 
 
 def test_action_map_confidence_floor_refractory_and_unmapped():
-    amap = ActionMap({1: "move_to_tool", 2: RobotCommand.CLOSE_GRIPPER, 3: "beep"},
-                     min_confidence=0.6, refractory_frames=30)
+    amap = ActionMap(
+        {1: "move_to_tool", 2: RobotCommand.CLOSE_GRIPPER, 3: "beep"},
+        min_confidence=0.6,
+        refractory_frames=30,
+    )
     assert amap.mapping[1] is RobotCommand.MOVE_TO_TOOL
     assert amap.mapping[3] == "beep"  # any command for other programs
     low = amap.decide(_event(1, 100, confidence=0.5))
@@ -143,14 +151,25 @@ def test_commander_drives_the_robot_from_events():
         _event(3, 200),  # open_gripper
         _event(5, 260),  # return_home, decided at flush
     ]
-    amap = ActionMap({1: "move_to_tool", 2: "close_gripper", 4: "carry_tool",
-                      3: "open_gripper", 5: "return_home"}, min_confidence=0.5)
+    amap = ActionMap(
+        {
+            1: "move_to_tool",
+            2: "close_gripper",
+            4: "carry_tool",
+            3: "open_gripper",
+            5: "return_home",
+        },
+        min_confidence=0.5,
+    )
     robot = SimulatedRobot()
     commander = GestureCommander(_ScriptedRecognizer(events), amap, robot)
     log = commander.run([None] * 240)
     assert len(log) == len(events)
-    issued = [(d.event.emitted_at, str(d.command), r.accepted, r.reason)
-              for d, r in log if d.issued]
+    issued = [
+        (d.event.emitted_at, str(d.command), r.accepted, r.reason)
+        for d, r in log
+        if d.issued
+    ]
     assert issued == [
         (50, "move_to_tool", True, "ok"),
         (60, "open_gripper", False, "the gripper holds nothing"),

@@ -194,6 +194,19 @@ def test_push_many_and_recognize_match_push(fitted, precog):
         assert [(e.label, e.start, e.end, e.emitted_at) for e in again] == one
 
 
+def test_balanced_schedule_gives_the_same_events_a_little_later(fitted, precog):
+    X_test, _ = _split(precog, TEST_SUBJECTS)
+    X = X_test[1]
+    eager = _push_all(StreamingRecognizer(fitted), X)
+    balanced = _push_all(StreamingRecognizer(fitted, schedule="balanced"), X)
+    assert len(eager) == len(balanced) > 0
+    for a, b in zip(eager, balanced):
+        assert (a.label, a.start, a.end) == (b.label, b.start, b.end)
+        assert a.emitted_at <= b.emitted_at <= a.emitted_at + 2
+    with pytest.raises(ValueError, match="schedule"):
+        StreamingRecognizer(fitted, schedule="lazy")
+
+
 def test_untracked_frames_are_held(fitted, precog):
     """Zeros and NaN frames (dropouts) are held: the events equal offline
     predict with ``fill="hold"`` exactly."""
@@ -217,7 +230,9 @@ def test_linear_fill_differs_only_around_dropouts(fitted, precog):
     X[dropouts] = 0.0
     rec = StreamingRecognizer(fitted)
     got = {tuple(int(v) for v in ev.to_segment()[:3]) for ev in rec.recognize(X)}
-    want = {tuple(int(v) for v in row[:3]) for row in _offline(fitted, X, fill="linear")}
+    want = {
+        tuple(int(v) for v in row[:3]) for row in _offline(fitted, X, fill="linear")
+    }
 
     def far(seg):
         return np.abs(dropouts[:, None] - np.arange(seg[1], seg[2])).min() > 30
@@ -239,8 +254,9 @@ def test_stream_starting_untracked_or_mid_gesture(fitted, precog):
     assert rec.n_frames_seen == 0  # flush reset the recogniser
     assert rec.max_backfill == 2 * 15 + 2 * 4 + 1
     skipped = 300 - rec.max_backfill
-    shifted = [(e.label, e.start - skipped, e.end - skipped, e.confidence)
-               for e in events]
+    shifted = [
+        (e.label, e.start - skipped, e.end - skipped, e.confidence) for e in events
+    ]
     _assert_same_segments_rows(shifted, _offline(fitted, very_late[skipped:]))
     # The stream starts in the middle of the first gesture.
     first = int(np.flatnonzero(y > 0)[0])
@@ -264,7 +280,7 @@ def test_one_hour_stream_keeps_bounded_buffers(cheap_pipeline, precog):
         assert set(lengths) == set(capacities)
         assert all(lengths[k] <= capacities[k] for k in lengths)
     # Fixed bounds, independent of the stream length.
-    assert capacities["raw"] == 8 and capacities["descriptors"] < 64
+    assert capacities["raw"] == 10 and capacities["descriptors"] < 64
     assert capacities["windows"] == 600 // 2 + 1
     # Always active: periods are force-closed every 600 frames and decided.
     n_events += len(rec.flush())
@@ -343,4 +359,3 @@ def test_invalid_pipelines_and_frames(cheap_pipeline, precog):
     with pytest.raises(ValueError, match="n_frames"):
         rec.push_many(np.zeros((4, 25, 3)))
     assert rec.flush() == []  # nothing tracked: nothing to decide
-

@@ -163,14 +163,16 @@ class PickAndPlaceRobot(ABC):
         before = self.state
         expected, after = TRANSITIONS[before]
         if command is not expected:
-            result = CommandResult(command, False, before, before,
-                                   _refusal(before, command), frame)
+            result = CommandResult(
+                command, False, before, before, _refusal(before, command), frame
+            )
         else:
             try:
                 self._perform(command)
             except Exception as exc:  # the hardware refused: state unchanged
-                result = CommandResult(command, False, before, before,
-                                       f"robot error: {exc}", frame)
+                result = CommandResult(
+                    command, False, before, before, f"robot error: {exc}", frame
+                )
             else:
                 self.state = after
                 result = CommandResult(command, True, before, after, "ok", frame)
@@ -298,10 +300,13 @@ class ActionMap:
 
     def __init__(self, mapping, *, min_confidence=0.0, refractory_frames=0):
         if not isinstance(min_confidence, Real) or not 0 <= min_confidence <= 1:
-            raise ValueError(f"min_confidence must be in [0, 1], got {min_confidence!r}")
+            raise ValueError(
+                f"min_confidence must be in [0, 1], got {min_confidence!r}"
+            )
         if not isinstance(refractory_frames, Integral) or refractory_frames < 0:
             raise ValueError(
-                f"refractory_frames must be a non-negative int, got {refractory_frames!r}"
+                "refractory_frames must be a non-negative int, got "
+                f"{refractory_frames!r}"
             )
         self.mapping = {int(k): _as_command(v) for k, v in dict(mapping).items()}
         self.min_confidence = min_confidence

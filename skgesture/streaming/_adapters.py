@@ -84,7 +84,16 @@ _KINECT_V2_SOURCES = {
     **{
         f"{part}{side}": (f"{part}{side}",)
         for side in ("Left", "Right")
-        for part in ("Shoulder", "Elbow", "Wrist", "Hand", "Hip", "Knee", "Ankle", "Foot")
+        for part in (
+            "Shoulder",
+            "Elbow",
+            "Wrist",
+            "Hand",
+            "Hip",
+            "Knee",
+            "Ankle",
+            "Foot",
+        )
     },
 }
 _AZURE_KINECT_SOURCES = {
@@ -95,7 +104,16 @@ _AZURE_KINECT_SOURCES = {
     **{
         f"{part}{side.title()}": (f"{part.upper()}_{side}",)
         for side in ("LEFT", "RIGHT")
-        for part in ("Shoulder", "Elbow", "Wrist", "Hand", "Hip", "Knee", "Ankle", "Foot")
+        for part in (
+            "Shoulder",
+            "Elbow",
+            "Wrist",
+            "Hand",
+            "Hip",
+            "Knee",
+            "Ankle",
+            "Foot",
+        )
     },
 }
 _MEDIAPIPE_SOURCES = {
@@ -336,18 +354,29 @@ class MediaPipePoseAdapter(SkeletonAdapter):
     name = "mediapipe_pose"
     mapping = _MEDIAPIPE_SOURCES
 
-    def __init__(self, *, coordinates="normalized", aspect_ratio=4 / 3,
-                 body_height=DEFAULT_BODY_HEIGHT, metres_per_unit=None,
-                 image_mirrored=False):
+    def __init__(
+        self,
+        *,
+        coordinates="normalized",
+        aspect_ratio=4 / 3,
+        body_height=DEFAULT_BODY_HEIGHT,
+        metres_per_unit=None,
+        image_mirrored=False,
+    ):
         if coordinates not in ("normalized", "world"):
             raise ValueError(
                 f"coordinates must be 'normalized' or 'world', got {coordinates!r}"
             )
-        for name, value in (("aspect_ratio", aspect_ratio), ("body_height", body_height)):
+        for name, value in (
+            ("aspect_ratio", aspect_ratio),
+            ("body_height", body_height),
+        ):
             if not value > 0:
                 raise ValueError(f"{name} must be positive, got {value!r}")
         if metres_per_unit is not None and not metres_per_unit > 0:
-            raise ValueError(f"metres_per_unit must be positive, got {metres_per_unit!r}")
+            raise ValueError(
+                f"metres_per_unit must be positive, got {metres_per_unit!r}"
+            )
         self.coordinates = coordinates
         self.aspect_ratio = aspect_ratio
         self.body_height = body_height
@@ -357,15 +386,18 @@ class MediaPipePoseAdapter(SkeletonAdapter):
     def _convert(self, X):
         M = _sources_matrix(self.mapping, MEDIAPIPE_POSE_LANDMARKS)
         out = np.einsum("kj,tjc->tkc", M, X)
-        hip, spine, centre = (KINECT_V1.index(j) for j in
-                              ("HipCenter", "Spine", "ShoulderCenter"))
+        hip, spine, centre = (
+            KINECT_V1.index(j) for j in ("HipCenter", "Spine", "ShoulderCenter")
+        )
         out[:, spine] = out[:, hip] + SPINE_FRACTION * (out[:, centre] - out[:, hip])
         if self.coordinates == "normalized":
             out[..., 1] /= self.aspect_ratio
             scale = self.metres_per_unit
             if scale is None:
                 torso = np.median(np.linalg.norm(out[:, centre] - out[:, hip], axis=-1))
-                scale = TORSO_HEIGHT_RATIO * self.body_height / torso if torso > 0 else 1.0
+                scale = (
+                    TORSO_HEIGHT_RATIO * self.body_height / torso if torso > 0 else 1.0
+                )
             out = out * scale
         flip = np.array([1.0 if self.image_mirrored else -1.0, -1.0, 1.0])
         return out * flip
@@ -499,14 +531,24 @@ class ReplaySource(SkeletonSource):
     (4, (20, 3), [0.1, 0.0, 2.0])
     """
 
-    def __init__(self, X, *, adapter=None, fps=20.0, realtime=False,
-                 clock=time.monotonic, sleep=time.sleep):
+    def __init__(
+        self,
+        X,
+        *,
+        adapter=None,
+        fps=20.0,
+        realtime=False,
+        clock=time.monotonic,
+        sleep=time.sleep,
+    ):
         if isinstance(adapter, str):
             adapter = get_adapter(adapter)
         self.adapter = adapter or KinectV1Adapter()
         self.X = np.asarray(X, dtype=np.float64)
         if self.X.ndim != 3:
-            raise ValueError(f"X must have shape (n_frames, n_joints, 3), got {self.X.shape}")
+            raise ValueError(
+                f"X must have shape (n_frames, n_joints, 3), got {self.X.shape}"
+            )
         if not fps > 0:
             raise ValueError(f"fps must be positive, got {fps!r}")
         self.fps = float(fps)

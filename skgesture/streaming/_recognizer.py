@@ -159,24 +159,35 @@ def _check_span(span, owner):
 
 
 def _proba_function(estimator):
-    """``predict_proba`` of a fitted 2-D classifier, without per-call validation
-    overhead for :class:`~skgesture.TorchMLPClassifier` (same numbers)."""
+    """``predict_proba`` of a fitted 2-D classifier, as a fast callable.
+
+    For a :class:`~skgesture.TorchMLPClassifier` on the CPU the module is called
+    directly: the same float32 forward pass and output map as
+    ``predict_proba`` (hence the same numbers), without its per-call input
+    validation and ``eval()`` walk, which cost more than the forward pass of one
+    row.
+    """
+    import torch
+
     from skgesture._mlp import TorchMLPClassifier
 
-    if isinstance(estimator, TorchMLPClassifier):
-        from skgesture._networks import predict_module
+    if not isinstance(estimator, TorchMLPClassifier):
+        return estimator.predict_proba
+    module = estimator.net_.module_
+    if next(module.parameters()).device.type != "cpu":
+        return estimator.predict_proba
+    module.eval()
+    binary = len(estimator.classes_) == 2
 
-        module = estimator.net_.module_
-        if len(estimator.classes_) == 2:
-
-            def proba(X):
-                p = predict_module(module, np.asarray(X, dtype=np.float32), "sigmoid")
+    def proba(X):
+        with torch.inference_mode():
+            logits = module(torch.from_numpy(np.asarray(X, dtype=np.float32)))
+            if binary:
+                p = torch.sigmoid(logits)[:, 0].numpy().astype(np.float64)
                 return np.column_stack([1.0 - p, p])
+            return torch.softmax(logits, dim=1).numpy().astype(np.float64)
 
-            return proba
-
-        return lambda X: predict_module(module, np.asarray(X, dtype=np.float32), "softmax")
-    return estimator.predict_proba
+    return proba
 
 
 class StreamingRecognizer:
@@ -209,6 +220,12 @@ class StreamingRecognizer:
     target_names : sequence of str or None, default=None
         ``target_names[k - 1]`` names class ``k`` in the events (as the
         dataset loaders' ``target_names``).
+    schedule : {"eager", "balanced"}, default="eager"
+        ``"eager"`` does all the work a frame allows in its own :meth:`push`.
+        ``"balanced"`` spreads it to lower the worst push: the descriptors of
+        two frames are computed every other push, and the decisions they lead
+        to (windows, periods, events) on the push in between. Same events,
+        emitted up to 2 frames later; :meth:`push_many` stays eager.
 
     Attributes
     ----------
@@ -273,7 +290,7 @@ class StreamingRecognizer:
     frame (offline: all of them), so when that pose counts as active the
     period starts later and its window grid may shift.
 
-    **Memory.** Ring buffers of raw frames (``2a``), descriptors and scores
+    **Memory.** Ring buffers of raw frames (``2a + 2``), descriptors and scores
     (a few dozen rows), the window scores of the open period (at most
     ``max_period / stride``) and one running sum (Method C): a stream of any
     length uses the same memory (:meth:`buffer_lengths`).
@@ -303,10 +320,18 @@ class StreamingRecognizer:
     True
     """
 
-    def __init__(self, pipeline, *, max_period=DEFAULT_MAX_PERIOD, target_names=None):
+    def __init__(
+        self,
+        pipeline,
+        *,
+        max_period=DEFAULT_MAX_PERIOD,
+        target_names=None,
+        schedule="eager",
+    ):
         self.pipeline = pipeline
         self.max_period = max_period
         self.target_names = target_names
+        self.schedule = schedule
         self._inspect()
         self.reset()
 
@@ -402,16 +427,21 @@ class StreamingRecognizer:
         self._origin = 0  # stream index of local frame 0
         self._floor = 0  # events found while back-filling are emitted here
         self._last_tracked = None
-        self._raw = _Ring(2 * self._reach, self._frame_shape)
+        # 2a frames of context, +2 for the frames a balanced push describes late.
+        self._raw = _Ring(2 * self._reach + 2, self._frame_shape)
         self._desc = _Ring(self._desc_capacity, (self._n_features,))
         self._scores = _Ring(self._score_capacity, (self._n_tracks,))
         self._score_time = _Ring(self._score_capacity, (), dtype=np.int64)
         self._n_smoothed = 0
         self._events = []
+        self._deferred = []  # smoothed blocks awaiting their decisions (balanced)
+        self._deferring = False
         if self.method == "multiscale":
             self._reset_run()
         else:
-            self._chunk_sum = np.zeros((self._window + self._chunk_step, self._n_tracks))
+            self._chunk_sum = np.zeros(
+                (self._window + self._chunk_step, self._n_tracks)
+            )
             self._chunk_count = np.zeros(self._window + self._chunk_step)
             self._chunk_base = 0  # local frame of _chunk_sum[0]
             self._next_chunk = 0  # start of the next regular chunk
@@ -483,8 +513,14 @@ class StreamingRecognizer:
             )
         for est in stages:
             check_is_fitted(est)
+        if self.schedule not in ("eager", "balanced"):
+            raise ValueError(
+                f"schedule must be 'eager' or 'balanced', got {self.schedule!r}"
+            )
         if not isinstance(self.max_period, Integral) or self.max_period < 1:
-            raise ValueError(f"max_period must be a positive int, got {self.max_period!r}")
+            raise ValueError(
+                f"max_period must be a positive int, got {self.max_period!r}"
+            )
         self._descriptor = desc
         self._spec = desc._spec()
         self._frame_shape = tuple(desc.frame_shape_in_)
@@ -497,7 +533,11 @@ class StreamingRecognizer:
         kinds = [type(est).__name__ for est in rest]
         if kinds == ["BiLSTMTagger"]:
             self._inspect_tagger(rest[0])
-        elif kinds == ["ActivitySegmenter", "DynamicPoseWindow", "MultiScaleClassifier"]:
+        elif kinds == [
+            "ActivitySegmenter",
+            "DynamicPoseWindow",
+            "MultiScaleClassifier",
+        ]:
             self._inspect_multiscale(*rest)
         elif kinds == ["DynamicPoseWindow", "MultiScaleClassifier"]:
             raise ValueError(
@@ -512,7 +552,9 @@ class StreamingRecognizer:
                 f"PoseDescriptor -> BiLSTMTagger (Method C), got {kinds}"
             )
         self.max_backfill = 2 * self._span + 2 * self._reach + 1
-        if self.target_names is not None and len(self.target_names) < max(self.classes_):
+        if self.target_names is not None and len(self.target_names) < max(
+            self.classes_
+        ):
             raise ValueError(
                 f"target_names has {len(self.target_names)} names but the classes go "
                 f"up to {max(self.classes_)}"
@@ -610,7 +652,11 @@ class StreamingRecognizer:
         self._events = []
         first_index = self.n_frames_seen
         self.n_frames_seen += len(frames)
-        missing = missing_frames(frames)
+        if len(frames) == 1:  # push(): the rule of missing_frames, for one frame
+            frame = frames[0]
+            missing = np.array([bool(np.isnan(frame).any() or not frame.any())])
+        else:
+            missing = missing_frames(frames)
         if self._last_tracked is None:
             if missing.all():
                 self._n_leading += len(frames)
@@ -627,19 +673,38 @@ class StreamingRecognizer:
             missing = np.concatenate([np.zeros(n_copies, dtype=bool), missing])
             self._last_tracked = frames[0]
         # Causal fill: hold the last tracked frame (offline default: linear).
-        held = _fill_missing(
-            np.concatenate([self._last_tracked[None], frames]),
-            np.concatenate([[False], missing]),
-            "hold",
-        )[1:]
+        if len(frames) == 1:  # push(): no need for the general fill
+            held = self._last_tracked[None] if missing[0] else frames
+        else:
+            held = _fill_missing(
+                np.concatenate([self._last_tracked[None], frames]),
+                np.concatenate([[False], missing]),
+                "hold",
+            )[1:]
         self._last_tracked = held[-1]
         context = self._raw.get(self._raw.first, self._raw.count)
         base = self._raw.first
         self._raw.extend(held)
+        now = self._raw.count - 1
         n_final = self._raw.count - self._reach  # descriptors final: frames < n_final
+        if self._deferred and (len(held) > 1 or self.schedule == "eager"):
+            self._drain(now)
+        elif self._deferred:  # balanced: this push makes the deferred decisions
+            self._drain(now)
+            return self._events
         if n_final > self._desc.count:
-            self._describe(np.concatenate([context, held]), base, n_final)
+            self._deferring = self.schedule == "balanced" and len(held) == 1
+            try:
+                self._describe(np.concatenate([context, held]), base, n_final)
+            finally:
+                self._deferring = False
         return self._events
+
+    def _drain(self, now):
+        """Make the decisions deferred by a balanced push, as of frame ``now``."""
+        deferred, self._deferred = self._deferred, []
+        for lo, values, times, raw in deferred:
+            self._decide_smoothed(lo, values, np.maximum(times, now), raw)
 
     def _describe(self, seq, base, stop):
         """Descriptors of local frames ``self._desc.count .. stop - 1`` from ``seq``
@@ -704,17 +769,27 @@ class StreamingRecognizer:
         first = self._scores.first
         smoothed = loess_smooth(self._scores.get(first, n), self._span, axis=0)
         lo = self._n_smoothed
-        self._on_smoothed(lo, smoothed[lo - first :], np.full(n - lo, self._raw.count - 1))
+        self._on_smoothed(
+            lo, smoothed[lo - first :], np.full(n - lo, self._raw.count - 1)
+        )
 
     def _on_smoothed(self, lo, values, times):
         self._n_smoothed = lo + len(values)
+        raw = None
+        if self.method == "tagger":
+            raw = self._scores.get(lo, lo + len(values))
+        if self._deferring:
+            self._deferred.append((lo, values, times, raw))
+        else:
+            self._decide_smoothed(lo, values, times, raw)
+
+    def _decide_smoothed(self, lo, values, times, raw):
         if self.method == "multiscale":
             active = values[:, 0] > self._threshold
             for i in range(len(values)):
                 self._on_activity(lo + i, bool(active[i]), int(times[i]))
         else:
             labels = self._tagger_classes[np.argmax(values, axis=1)]
-            raw = self._scores.get(lo, lo + len(values))
             for i in range(len(values)):
                 self._on_label(lo + i, labels[i], raw[i], int(times[i]))
 
@@ -938,8 +1013,9 @@ class StreamingRecognizer:
             if done:
                 held = self._scores.get(s, s + done)
                 counts = self._released_counts(s, s + done)
-                self._scores.set(s, (held * counts[:, None] + proba[:done]) /
-                                 (counts[:, None] + 1))
+                self._scores.set(
+                    s, (held * counts[:, None] + proba[:done]) / (counts[:, None] + 1)
+                )
             i = max(s - self._chunk_base, 0)
             self._chunk_sum[i : i + (e - s - done)] += proba[done:]
             self._chunk_count[i : i + (e - s - done)] += 1
@@ -977,6 +1053,7 @@ class StreamingRecognizer:
 
     def _finish(self):
         n = self._raw.count
+        self._drain(n - 1)
         if n > self._desc.count:
             self._describe(self._raw.get(self._raw.first, n), self._raw.first, n)
         if self.method == "tagger":
