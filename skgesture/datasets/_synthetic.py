@@ -657,6 +657,9 @@ def _make_stream(
         noise_rng.standard_normal(out=X)
         X *= noise
     _forward_kinematics(arm, torso, subject["body"], root_rot, root + root_sway, X)
+    # Body x is the subject's left; a subject facing a Kinect v1 has the left side
+    # at camera -x (as in every real recording in shared/data), so mirror x.
+    X[..., 0] *= -1.0
 
     missing = np.zeros(n_total, dtype=bool)
     if dropout_rate > 0:

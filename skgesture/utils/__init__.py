@@ -1,9 +1,11 @@
-"""Shared helpers: sequence validation, segments, smoothing, resizing, SCG."""
+"""Shared helpers: sequence validation, segments, smoothing, resizing, SCG.
+
+``SCG`` is imported lazily: ``import skgesture.utils`` does not import torch.
+"""
 
 # SPDX-License-Identifier: BSD-3-Clause
 
 from skgesture.utils._resize import imresize_weights, resize_frames
-from skgesture.utils._scg import SCG
 from skgesture.utils._segments import (
     labels_to_segments,
     remove_short_runs,
@@ -31,3 +33,11 @@ __all__ = [
     "imresize_weights",
     "SCG",
 ]
+
+
+def __getattr__(name):
+    if name == "SCG":
+        from skgesture.utils._scg import SCG
+
+        return SCG
+    raise AttributeError(f"module 'skgesture.utils' has no attribute {name!r}")
