@@ -60,7 +60,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
     random_state : int, RandomState instance or None, default=None
         Seeds the initialisation, the data division and the shuffling.
     verbose : int, default=0
-        Print the epoch table when > 1.
+        0 is silent, 1 shows a tqdm bar over epochs, 2 prints skorch's epoch table.
 
     Attributes
     ----------

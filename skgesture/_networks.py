@@ -201,6 +201,29 @@ class _MatlabStopping(Callback):
             net.best_epoch_ = self.best_epoch_
 
 
+class EpochProgress(Callback):
+    """A tqdm bar over epochs showing the latest losses (``verbose=1``)."""
+
+    def on_train_begin(self, net, **kwargs):
+        from tqdm.auto import tqdm
+
+        self.bar_ = tqdm(
+            total=net.max_epochs,
+            desc=type(net.module_).__name__,
+            unit="epoch",
+            leave=False,
+        )
+
+    def on_epoch_end(self, net, **kwargs):
+        row = net.history[-1]
+        losses = {k: f"{row[k]:.4f}" for k in ("train_loss", "valid_loss") if k in row}
+        self.bar_.set_postfix(losses, refresh=False)
+        self.bar_.update(1)
+
+    def on_train_end(self, net, **kwargs):
+        self.bar_.close()
+
+
 def _solver_settings(solver, learning_rate, batch_size, n_samples):
     """Optimizer class, its keyword arguments and the batch size for ``solver``."""
     if solver == "scg":
@@ -253,7 +276,9 @@ def build_net(
     else:
         split = _TrainOnly()
     callbacks = [("matlab_stop", _MatlabStopping(max_fail=max_fail))]
-    if verbose > 1:
+    if verbose == 1:
+        callbacks.append(("progress", EpochProgress()))
+    elif verbose > 1:
         callbacks += [("epoch_timer", EpochTimer()), ("print_log", PrintLog())]
     return NeuralNet(
         MLPModule,
