@@ -29,7 +29,7 @@ _LAZY = {
     "segments_to_labels": "skgesture.utils._segments",
 }
 
-_SUBMODULES = {"datasets", "metrics", "utils", "layouts", "streaming"}
+_SUBMODULES = {"datasets", "metrics", "utils", "layouts", "streaming", "plotting"}
 
 __all__ = sorted(_LAZY) + sorted(_SUBMODULES) + ["__version__"]
 
