@@ -325,7 +325,8 @@ def test_multiscale_confidence_is_the_mean_normalised_fused_score():
     # by hand: windows at centres 4, 6, .., 24 of the 30-frame clip (§6.2)
     centres = np.arange(4, 26, 2)
     fused = sum(
-        w * est.predict_proba(test[0][centres, k])
+        # the classifier works on float32 windows (DynamicPoseWindow's dtype)
+        w * est.predict_proba(test[0][centres, k].astype(np.float32))
         for k, (w, est) in enumerate(zip((0.75, 0.25), a.estimators_))
     )
     top = fused.max(axis=1)
