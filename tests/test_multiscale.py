@@ -326,7 +326,7 @@ def test_multiscale_confidence_is_the_mean_normalised_fused_score():
     centres = np.arange(4, 26, 2)
     fused = sum(
         # the classifier works on float32 windows (DynamicPoseWindow's dtype)
-        w * est.predict_proba(test[0][centres, k].astype(np.float32))
+        w * est.predict_proba(test[0][centres, k].astype(np.float32)).astype(float)
         for k, (w, est) in enumerate(zip((0.75, 0.25), a.estimators_))
     )
     top = fused.max(axis=1)
