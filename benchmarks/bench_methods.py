@@ -5,34 +5,63 @@
   sequences of unseen subjects.
 """
 
+import tempfile
 import time
 
 import numpy as np
 from _baseline import SlidingWindowForest
-from sklearn.model_selection import LeaveOneGroupOut
+from joblib import Memory
+from sklearn.model_selection import GridSearchCV, GroupKFold, LeaveOneGroupOut
 
-from skgesture import make_method_a, make_method_b
+from skgesture import make_method_a, make_method_b, make_method_c
 from skgesture.datasets import load_precog, make_gesture_streams
-from skgesture.metrics import frame_accuracy, jaccard_index
+from skgesture.metrics import frame_accuracy, jaccard_index, jaccard_scorer
+
+ALL_METHODS = ("forest", "A", "B", "B (tuned)", "C (cpu)")
+DEFAULT_METHODS = ALL_METHODS
+
+# Decision parameters searched for "B (tuned)": segmenter threshold and the
+# classifier's thresholds; the networks are trained once per inner fold.
+TUNING_GRID = [
+    {
+        "segmenter__threshold": [0.3, 0.4, 0.5],
+        "classifier__threshold_short": [0.6014],
+        "classifier__threshold_long": [0.6033],
+    },
+    {
+        "segmenter__threshold": [0.3, 0.4, 0.5],
+        "classifier__threshold_short": [0.4],
+        "classifier__threshold_long": [0.4],
+    },
+]
 
 
-def _methods(joints, random_state, include_c):
+def _tuned_b(joints, random_state, memory_dir):
+    """Method B whose decision parameters are chosen by an inner GroupKFold(2)."""
+    model = make_method_b(
+        joints=joints, memory=Memory(memory_dir, verbose=0), random_state=random_state
+    )
+    return GridSearchCV(model, TUNING_GRID, scoring=jaccard_scorer, cv=GroupKFold(2))
+
+
+def _methods(joints, random_state, include, memory_dir):
     out = {
         "forest": lambda: SlidingWindowForest(random_state=random_state),
         "A": lambda: make_method_a(joints=joints, random_state=random_state),
         "B": lambda: make_method_b(joints=joints, random_state=random_state),
+        "B (tuned)": lambda: _tuned_b(joints, random_state, memory_dir),
+        "C (cpu)": lambda: make_method_c(joints=joints, random_state=random_state),
     }
-    if include_c:
-        from skgesture import make_method_c
-
-        out["C (cpu)"] = lambda: make_method_c(joints=joints, random_state=random_state)
-    return out
+    return {name: out[name] for name in include}
 
 
-def _evaluate(make, X_tr, y_tr, X_te, y_te):
+def _evaluate(make, X_tr, y_tr, X_te, y_te, groups_tr):
     est = make()
     t0 = time.perf_counter()
-    est.fit(X_tr, y_tr)
+    if isinstance(est, GridSearchCV):
+        est.fit(X_tr, y_tr, groups=groups_tr)
+    else:
+        est.fit(X_tr, y_tr)
     fit_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     pred = est.predict(X_te)
@@ -44,6 +73,8 @@ def _evaluate(make, X_tr, y_tr, X_te, y_te):
         "fit_s": fit_s,
         "pred_us_per_frame": 1e6 * pred_s / sum(len(x) for x in X_te),
     }
+    if isinstance(est, GridSearchCV):
+        est = est.best_estimator_
     if hasattr(est, "named_steps") and "segmenter" in est.named_steps:
         Xd = est[:1].transform(X_te)
         row["segmenter_acc"] = est.named_steps["segmenter"].score(Xd, y_te)
@@ -55,36 +86,39 @@ def _mean_rows(rows):
     return {k: float(np.mean([r[k] for r in rows])) for k in keys}
 
 
-def precog_rows(quick=False, include_c=False, random_state=0):
+def _split(data, tr, te):
+    return (
+        [data.X[i] for i in tr],
+        [data.y[i] for i in tr],
+        [data.X[i] for i in te],
+        [data.y[i] for i in te],
+        np.asarray(data.groups)[tr],
+    )
+
+
+def precog_rows(quick=False, include=DEFAULT_METHODS, random_state=0):
+    """PRECOG (bundled subjects 1-8), leave-one-subject-out, 20 joints."""
     data = load_precog()
     groups = np.asarray(data.groups)
     folds = list(LeaveOneGroupOut().split(data.X, groups=groups))
     if quick:
         folds = folds[:2]
     rows = []
-    for name, make in _methods("full20", random_state, include_c).items():
-        per_fold = []
-        for tr, te in folds:
-            per_fold.append(
-                _evaluate(
-                    make,
-                    [data.X[i] for i in tr],
-                    [data.y[i] for i in tr],
-                    [data.X[i] for i in te],
-                    [data.y[i] for i in te],
-                )
+    with tempfile.TemporaryDirectory() as memory_dir:
+        for name, make in _methods("full20", random_state, include, memory_dir).items():
+            per_fold = [_evaluate(make, *_split(data, tr, te)) for tr, te in folds]
+            rows.append(
+                {
+                    "data": f"PRECOG LOSO ({len(folds)} folds)",
+                    "method": name,
+                    **_mean_rows(per_fold),
+                }
             )
-        rows.append(
-            {
-                "data": f"PRECOG LOSO ({len(folds)} folds)",
-                "method": name,
-                **_mean_rows(per_fold),
-            }
-        )
     return rows
 
 
-def synthetic_rows(quick=False, include_c=False, random_state=0):
+def synthetic_rows(quick=False, include=DEFAULT_METHODS, random_state=0):
+    """Synthetic streams: 100 training sequences, 50 test sequences of new subjects."""
     n_train, n_test = (30, 15) if quick else (100, 50)
     data = make_gesture_streams(
         n_train + n_test, n_subjects=(n_train + n_test) // 5, random_state=random_state
@@ -95,15 +129,14 @@ def synthetic_rows(quick=False, include_c=False, random_state=0):
     te = np.flatnonzero(np.isin(groups, test_subjects))
     tr = np.flatnonzero(~np.isin(groups, test_subjects))
     rows = []
-    for name, make in _methods("paper11", random_state, include_c).items():
-        row = _evaluate(
-            make,
-            [data.X[i] for i in tr],
-            [data.y[i] for i in tr],
-            [data.X[i] for i in te],
-            [data.y[i] for i in te],
-        )
-        rows.append({"data": f"synthetic {len(tr)}/{len(te)}", "method": name, **row})
+    with tempfile.TemporaryDirectory() as memory_dir:
+        for name, make in _methods(
+            "paper11", random_state, include, memory_dir
+        ).items():
+            row = _evaluate(make, *_split(data, tr, te))
+            rows.append(
+                {"data": f"synthetic {len(tr)}/{len(te)}", "method": name, **row}
+            )
     return rows
 
 
@@ -119,19 +152,24 @@ COLUMNS = [
 ]
 
 
-def run(quick=False, include_c=False):
-    return precog_rows(quick, include_c) + synthetic_rows(quick, include_c)
+def run(quick=False, include=DEFAULT_METHODS, datasets=("precog", "synthetic")):
+    rows = []
+    if "precog" in datasets:
+        rows += precog_rows(quick, include)
+    if "synthetic" in datasets:
+        rows += synthetic_rows(quick, include)
+    return rows
 
 
 if __name__ == "__main__":
-    import sys
+    import argparse
 
     from _common import format_table
 
-    print(
-        format_table(
-            run(quick="--quick" in sys.argv, include_c="--c" in sys.argv),
-            COLUMNS,
-            "Jaccard and cost per method",
-        )
-    )
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--methods", default=",".join(DEFAULT_METHODS))
+    parser.add_argument("--datasets", default="precog,synthetic")
+    args = parser.parse_args()
+    rows = run(args.quick, args.methods.split(","), args.datasets.split(","))
+    print(format_table(rows, COLUMNS, "Jaccard and cost per method"))

@@ -1,7 +1,13 @@
 """The per-frame pose descriptor of Brás, Simão & Neto (183-D for 11 joints).
 
-Every helper below works on one sequence and is vectorised over its frames; the
-only Python loops run over the 13 links of the skeleton tree.
+The computation works on *coordinate planes*: points over time are held as a
+``(3, n_points, n_frames)`` array, so that every arithmetic step runs on
+contiguous ``(n_points, n_frames)`` blocks of one coordinate instead of on tiny
+trailing axes of size 3. ``transform`` concatenates whole sequences into
+batches (about ``BATCH_VALUES`` descriptor values each); every sequence gets
+``EDGE`` padding frames at both ends, so that the temporal filter and the
+derivatives never cross a sequence boundary, and one vectorised pass describes
+the whole batch, writing each feature group into its rows of one output array.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -25,9 +31,14 @@ from skgesture.utils._validation import check_sequences, missing_frames
 __all__ = ["PoseDescriptor"]
 
 GAUSSIAN_SIZE = 5  # METHOD_SPEC §3.6: fspecial('gaussian', [5 1], 1)
+DERIVATIVE_REACH = 2  # METHOD_SPEC §3.7: the acceleration looks 2 frames each way
+EDGE = max((GAUSSIAN_SIZE - 1) // 2, DERIVATIVE_REACH)  # padding per sequence end
 MIN_NORM = 1e-8  # METHOD_SPEC §3.9-3.11: below this a vector is degenerate
 MIN_SCALE = 1e-8  # METHOD_SPEC §3.14: a feature with smaller std keeps scale 1
 DEGENERATE_INCLINATION = np.pi / 2  # METHOD_SPEC decision D8
+BATCH_VALUES = 750_000  # descriptor values per vectorised pass (4096 frames of
+# 183 features): large enough to amortise the Python overhead, small enough
+# for the intermediates to stay in cache
 
 
 def gaussian_kernel(sigma, size=GAUSSIAN_SIZE):
@@ -56,6 +67,9 @@ def gaussian_kernel(sigma, size=GAUSSIAN_SIZE):
     return w / w.sum()
 
 
+# -- time axis -----------------------------------------------------------------
+
+
 def _pad_time(P, h, border):
     """Pad ``P`` with ``h`` frames on both ends along axis 0."""
     if h == 0:
@@ -64,77 +78,268 @@ def _pad_time(P, h, border):
     return np.pad(P, [(h, h)] + [(0, 0)] * (P.ndim - 1), mode=mode)
 
 
-def _smooth_time(P, kernel, border):
-    """Centred correlation of every column of ``P`` with ``kernel`` (§3.6)."""
-    h = (len(kernel) - 1) // 2
-    Pp = _pad_time(P, h, border)
-    T = len(P)
-    out = kernel[0] * Pp[0:T]
+def _correlate(Pp, kernel, out):
+    """``out[..., t] = sum_m kernel[m] * Pp[..., t + m]`` along the last axis."""
+    n = out.shape[-1]
+    tmp = np.empty_like(out)
+    np.multiply(Pp[..., 0:n], kernel[0], out=out)
     for m in range(1, len(kernel)):
-        out = out + kernel[m] * Pp[m : m + T]
+        out += np.multiply(Pp[..., m : m + n], kernel[m], out=tmp)
     return out
 
 
-def _fill_missing(q, missing, method):
-    """Fill untracked frames of a ``(T, J, 3)`` sequence (METHOD_SPEC §3.3, D11).
+def _smooth_time(P, kernel, border):
+    """Centred correlation of every column of ``P`` with ``kernel`` (§3.6)."""
+    h = (len(kernel) - 1) // 2
+    Pp = np.moveaxis(_pad_time(P, h, border), 0, -1)
+    out = _correlate(Pp, kernel, np.empty(Pp.shape[:-1] + (len(P),)))
+    return np.moveaxis(out, -1, 0)
 
-    ``"linear"`` interpolates between the nearest tracked frames on both sides;
-    leading and trailing runs copy the nearest tracked frame. ``"hold"`` repeats
-    the last tracked frame.
+
+def _derivatives(pos, vel, acc):
+    """Velocities and accelerations (§3.7) of frames along the last axis.
+
+    Central differences over 1 and 2 frames; the outermost frames, which lack
+    a neighbour, get 0.
     """
+    vel[..., :1] = vel[..., -1:] = acc[..., :2] = acc[..., -2:] = 0.0
+    np.subtract(pos[..., 2:], pos[..., :-2], out=vel[..., 1:-1])
+    inner = np.add(pos[..., 4:], pos[..., :-4], out=acc[..., 2:-2])
+    inner -= 2.0 * pos[..., 2:-2]
+
+
+# -- batches of sequences ------------------------------------------------------
+
+
+def _batches(lengths, size):
+    """Split sequence indices into consecutive runs of about ``size`` frames."""
+    batches, batch, n = [], [], 0
+    for i, T in enumerate(lengths):
+        batch.append(i)
+        n += T
+        if n >= size:
+            batches.append(batch)
+            batch, n = [], 0
+    return batches + [batch] if batch else batches
+
+
+def _fill_plan(missing, method):
+    """How to fill untracked frames (METHOD_SPEC §3.3, D11): ``(cols, prev, nxt, w)``.
+
+    Untracked frame ``cols[i]`` becomes ``q[prev[i]] + w[i] * (q[nxt[i]] -
+    q[prev[i]])``: ``"linear"`` interpolates between the nearest tracked frames
+    on both sides, leading and trailing runs copy the nearest tracked frame.
+    ``"hold"`` repeats the last tracked frame (``nxt`` and ``w`` are None).
+    """
+    cols = np.flatnonzero(missing)
+    tracked = np.flatnonzero(~missing)
+    k = np.searchsorted(tracked, cols)  # next tracked frame
+    prev = tracked[np.maximum(k - 1, 0)]
+    if method == "hold":
+        return cols, prev, None, None
+    nxt = tracked[np.minimum(k, len(tracked) - 1)]
+    span = (nxt - prev).astype(float)
+    w = np.where(span > 0, (cols - prev) / np.where(span > 0, span, 1.0), 0.0)
+    return cols, prev, nxt, w
+
+
+def _fill_missing(q, missing, method):
+    """Fill the untracked frames of a ``(T, ...)`` sequence (METHOD_SPEC §3.3)."""
     if not missing.any():
         return q
-    T = len(q)
-    t = np.arange(T)
-    valid = ~missing
-    first = int(np.argmax(valid))
-    last = T - 1 - int(np.argmax(valid[::-1]))
-    prev = np.maximum.accumulate(np.where(valid, t, -1))
-    prev[:first] = first
-    if method == "hold":
-        return q[prev]
-    nxt = np.minimum.accumulate(np.where(valid, t, T)[::-1])[::-1]
-    nxt[last + 1 :] = last
-    span = (nxt - prev).astype(float)
-    w = np.where(span > 0, (t - prev) / np.where(span > 0, span, 1.0), 0.0)
-    return q[prev] + w[:, None, None] * (q[nxt] - q[prev])
+    q = q.copy()
+    _fill_frames(np.moveaxis(q, 0, -1), missing, method)
+    return q
 
 
-def _link_normalise(q, links, lengths, direction):
-    """Rescale every link of the tree to its reference length (METHOD_SPEC §3.5).
+def _fill_frames(planes, missing, method):
+    """Fill, in place, the untracked frames along the last axis of ``planes``."""
+    cols, prev, nxt, w = _fill_plan(missing, method)
+    filled = planes[..., prev]
+    if nxt is not None:
+        filled += w * (planes[..., nxt] - filled)
+    planes[..., cols] = filled
 
-    ``q`` is root-centred ``(T, J, 3)``; ``links`` holds index pairs in tree order.
+
+def _sequence_planes(X, lengths, fill):
+    """Concatenate ``(T_i, J, 3)`` sequences as planes ``(3, J, sum T_i)``.
+
+    Untracked frames (all zeros or any NaN) are filled by the ``fill`` rule; a
+    sequence without any tracked frame is set to zeros and flagged in the
+    returned mask.
     """
-    p = q.copy()
-    for (a, b), length in zip(links, lengths):
-        origin = q[:, a] if direction == "original" else p[:, a]
-        v = q[:, b] - origin
-        norm = _norm(v)[:, None]
-        p[:, b] = p[:, a] + v * (length / np.where(norm > 0, norm, np.inf))
-    return p
+    starts = np.cumsum(lengths) - lengths
+    Q = np.empty(X[0].shape[:0:-1] + (lengths.sum(),))
+    for seq, a, T in zip(X, starts, lengths):
+        Q[..., a : a + T] = seq.T
+    flat = Q.reshape(-1, Q.shape[-1])
+    # All zeros, or a NaN (max and min propagate it).
+    missing = ~((flat.max(axis=0) > 0) | (flat.min(axis=0) < 0))
+    untracked = np.zeros(len(X), dtype=bool)
+    if missing.any():
+        for i, (a, T) in enumerate(zip(starts, lengths)):
+            miss = missing[a : a + T]
+            untracked[i] = miss.all()
+            if untracked[i]:
+                flat[:, a : a + T] = 0.0  # described as a still skeleton, then reset
+            elif miss.any():
+                _fill_frames(flat[:, a : a + T], miss, fill)
+    return Q, untracked
+
+
+def _segment_offsets(lengths):
+    """Start of every segment ``[EDGE pads | T_i frames | EDGE pads]`` of a batch
+    laid out back to back, and the total number of padded frames."""
+    ends = np.cumsum(lengths + 2 * EDGE)
+    return ends - (lengths + 2 * EDGE), int(ends[-1])
+
+
+def _pad_segments(A, lengths, offsets, border):
+    """Set, in place, the padding frames (columns) of every segment of ``A``.
+
+    ``"replicate"`` copies the edge frame, ``"symmetric"`` mirrors the frames
+    next to the edge (edge included, as ``np.pad``), ``"zero"`` writes zeros.
+    """
+    T = lengths[:, None]
+    rel = np.arange(-EDGE, EDGE)  # padding frames relative to each sequence
+    rel = np.where(rel < 0, rel, rel + T)
+    if border == "symmetric":
+        u = rel % (2 * T)
+        frame = np.where(u < T, u, 2 * T - 1 - u)
+    else:
+        frame = np.clip(rel, 0, T - 1)
+    first = offsets[:, None] + EDGE
+    if border == "zero":
+        A[:, (first + rel).ravel()] = 0.0
+    else:
+        A[:, (first + rel).ravel()] = A[:, (first + frame).ravel()]
+
+
+def _padded(P, lengths, offsets, n, border):
+    """Frames (columns) of concatenated sequences in the padded layout."""
+    out = np.empty(P.shape[:-1] + (n,))
+    for o, a, T in zip(offsets + EDGE, np.cumsum(lengths) - lengths, lengths):
+        out[:, o : o + T] = P[:, a : a + T]
+    _pad_segments(out, lengths, offsets, border)
+    return out
+
+
+def _smoothed(P, lengths, offsets, n, kernel, border):
+    """Rows ``P`` of concatenated frames smoothed by ``kernel`` (§3.6; None: not
+    smoothed), in the padded layout with replicated padding frames (§3.7)."""
+    if kernel is None:
+        return _padded(P, lengths, offsets, n, "replicate")
+    h = (len(kernel) - 1) // 2
+    Pp = _padded(P, lengths, offsets, n, border)
+    S = np.empty_like(Pp)
+    _correlate(Pp, kernel, S[:, h : n - h])
+    _pad_segments(S, lengths, offsets, "replicate")
+    return S
+
+
+# -- coordinate planes ---------------------------------------------------------
+
+
+def _planes(P):
+    """``(T, ..., 3)`` points as ``(3, ..., T)`` coordinate planes (a copy)."""
+    return np.array(P.T, order="C")
+
+
+def _points(A):
+    """``(3, ..., T)`` coordinate planes back as ``(T, ..., 3)`` points."""
+    return np.ascontiguousarray(A.T)
+
+
+def _dot(u, v, out=None):
+    """Dot product of the vectors of coordinate planes ``(3, ...)``.
+
+    Sums ``(x + z) + y``, the order of ``np.einsum`` over a length-3 axis, so the
+    results match an einsum-based computation bit for bit.
+    """
+    out = np.multiply(u[0], v[0], out=out)
+    tmp = np.multiply(u[2], v[2])
+    out += tmp
+    out += np.multiply(u[1], v[1], out=tmp)
+    return out
 
 
 def _norm(v):
-    """Euclidean norm along the last axis (einsum: faster than ``linalg.norm``)."""
-    return np.sqrt(np.einsum("...i,...i->...", v, v))
+    """Euclidean norm of the vectors of coordinate planes ``(3, ...)``."""
+    n = _dot(v, v)
+    return np.sqrt(n, out=n)
 
 
-def _unit(v):
-    """Unit vectors along the last axis and the mask of usable (non-zero) ones."""
+def _cross(u, v):
+    """Cross product of the vectors of coordinate planes ``(3, ...)``."""
+    out = np.empty(np.broadcast_shapes(u.shape, v.shape))
+    for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+        np.multiply(u[j], v[k], out=out[i])
+        out[i] -= u[k] * v[j]
+    return out
+
+
+def _unit(v, out=None):
+    """Unit vectors of coordinate planes ``(3, ...)`` and the mask of usable
+    (non-zero) ones."""
     n = _norm(v)
     ok = n > MIN_NORM
-    return v / np.where(ok, n, 1.0)[..., None], ok
+    np.maximum(n, MIN_NORM, out=n)  # any divisor will do where not ok
+    return np.divide(v, n, out=out), ok
 
 
-def _smallest_eigvec(C):
-    """Eigenvector of the smallest eigenvalue of symmetric ``(T, 3, 3)`` matrices.
+def _arccos(cos, ok, fallback, out):
+    """``arccos`` of cosines into ``out``, ``fallback`` where not ``ok``."""
+    np.arccos(np.clip(cos, -1.0, 1.0, out=cos), out=out)
+    if not ok.all():
+        np.copyto(out, fallback, where=~ok)
+    return out
 
-    Closed form (trigonometric eigenvalues, then the longest cross product of two
-    rows of ``C - lambda I``): an order of magnitude faster than a batched
-    ``eigh`` on many tiny matrices.
+
+# -- descriptor steps on coordinate planes -------------------------------------
+
+
+def _link_scales(v, lengths):
+    """Factors rescaling the vectors ``v`` to ``lengths``; 0 for zero vectors."""
+    norm = _norm(v)
+    norm[norm <= 0] = np.inf
+    return np.divide(lengths, norm, out=norm)
+
+
+def _link_normalise_planes(q, links, lengths, direction):
+    """Rescale, in place, every link of the tree to its reference length (§3.5).
+
+    ``q`` holds root-centred joints as planes ``(3, J, n)``; ``links`` holds index
+    pairs in tree order, parents first, so every parent is final before its
+    children and every child is read before it is overwritten.
     """
-    a, b, c = C[:, 0, 0], C[:, 1, 1], C[:, 2, 2]
-    d, e, f = C[:, 0, 1], C[:, 1, 2], C[:, 0, 2]
+    if direction == "original":  # directions of the original links
+        v = q[:, links[:, 1]] - q[:, links[:, 0]]
+        v *= _link_scales(v, lengths[:, None])
+    for k, (a, b) in enumerate(links):
+        if direction == "original":
+            w = v[:, k]
+        else:  # from the normalised parent to the original child
+            w = q[:, b] - q[:, a]
+            w *= _link_scales(w, lengths[k])
+        np.add(q[:, a], w, out=q[:, b])
+    return q
+
+
+def _link_normalise(q, links, lengths, direction):
+    """Link-normalised copy of a ``(T, J, 3)`` sequence."""
+    return _points(_link_normalise_planes(_planes(q), links, lengths, direction))
+
+
+def _smallest_eigvec(cov):
+    """Eigenvector of the smallest eigenvalue of symmetric 3x3 matrices.
+
+    ``cov`` holds the entries ``(a, b, c, d, e, f)`` = (xx, yy, zz, xy, yz, xz) as
+    rows of frames. Closed form (trigonometric eigenvalues, then the longest
+    cross product of two rows of ``C - lambda I``): much faster than a batched
+    ``eigh`` on many tiny matrices. Returns planes ``(3, n)`` and the mask of
+    well-defined ones.
+    """
+    a, b, c, d, e, f = cov
     q = (a + b + c) / 3.0
     p1 = d * d + e * e + f * f
     p2 = (a - q) ** 2 + (b - q) ** 2 + (c - q) ** 2 + 2.0 * p1
@@ -149,87 +354,145 @@ def _smallest_eigvec(C):
     )
     phi = np.arccos(np.clip(detB / 2.0, -1.0, 1.0)) / 3.0
     lam = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)  # smallest eigenvalue
-    M = C - lam[:, None, None] * np.eye(3)
-    r0, r1, r2 = M[:, 0], M[:, 1], M[:, 2]
-    cands = np.stack([np.cross(r0, r1), np.cross(r0, r2), np.cross(r1, r2)], axis=1)
-    norms = _norm(cands)
-    best = np.argmax(norms, axis=1)
-    rows = np.arange(len(C))
-    v = cands[rows, best]
-    n = norms[rows, best]
+    # Rows r0, r1, r2 of the symmetric C - lambda I, as planes (3, 3, n).
+    rows = np.array([[a - lam, d, f], [d, b - lam, e], [f, e, c - lam]])
+    cands = _cross(rows[:, [0, 0, 1]], rows[:, [1, 2, 2]])  # r0xr1, r0xr2, r1xr2
+    n0, n1, n2 = norms = _norm(cands)
+    # The longest candidate, the first one on ties (as argmax).
+    take0 = (n0 >= n1) & (n0 >= n2)
+    take1 = ~take0 & (n1 >= n2)
+    v, n = cands[:, 2], norms[2]
+    for k, take in ((1, take1), (0, take0)):
+        np.copyto(v, cands[:, k], where=take)
+        np.copyto(n, norms[k], where=take)
     ok = n > MIN_NORM * np.maximum(p, MIN_NORM) ** 2
-    return v / np.where(n > 0, n, 1.0)[:, None], ok
+    n[n <= 0] = 1.0
+    v /= n
+    return v, ok
 
 
-def _body_frame(P, torso, left_right, spine):
-    """Per-frame body axes ``u_x, u_z`` from the torso plane (METHOD_SPEC §3.8)."""
-    T = len(P)
-    torso_pts = P[:, torso]
-    centred = torso_pts - torso_pts.mean(axis=1, keepdims=True)
-    cov = np.einsum("tki,tkj->tij", centred, centred)
+def _body_frame_planes(S, torso, left_right, spine, offsets=None):
+    """Per-frame body axes ``u_x, u_z`` (planes ``(3, n)``), METHOD_SPEC §3.8.
+
+    ``S`` holds the joints as planes ``(3, K, n)``. ``offsets`` are the first
+    frames of the sequences laid out back to back in ``S`` (``None``: a single
+    sequence): a degenerate frame reuses the basis of the previous good frame of
+    its own sequence, or the camera axes.
+    """
+    pts = S[:, torso]
+    pts -= pts.mean(axis=1, keepdims=True)
+    cov = np.empty((6,) + pts.shape[2:])
+    for k, (i, j) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))):
+        np.add.reduce(pts[i] * pts[j], axis=0, out=cov[k])
     n, ok_n = _smallest_eigvec(cov)
-    left, right = P[:, left_right[0]], P[:, left_right[1]]
-    up = P[:, spine[1]] - P[:, spine[0]]
-    s = np.cross(left - right, up)
+    up = S[:, spine[1]] - S[:, spine[0]]
+    s = _cross(S[:, left_right[0]] - S[:, left_right[1]], up)
     ok_s = _norm(s) > MIN_NORM  # collinear shoulders and spine: no orientation
-    sign = np.where(np.einsum("ti,ti->t", n, s) < 0, -1.0, 1.0)
-    u_z = n * sign[:, None]
-    u_y, ok_y = _unit(up - np.einsum("ti,ti->t", up, u_z)[:, None] * u_z)
-    u_x = np.cross(u_y, u_z)
+    u_z = np.negative(n, out=n, where=_dot(n, s) < 0)
+    u_y, ok_y = _unit(up - _dot(up, u_z) * u_z)
+    u_x = _cross(u_y, u_z)
     ok = ok_n & ok_y & ok_s
     if not ok.all():
-        # Degenerate frames reuse the previous frame's basis; camera axes before
-        # the first good frame (METHOD_SPEC §3.8).
-        idx = np.maximum.accumulate(np.where(ok, np.arange(T), -1))
-        eye = np.eye(3)
-        u_x = np.where((idx >= 0)[:, None], u_x[np.maximum(idx, 0)], eye[0])
-        u_z = np.where((idx >= 0)[:, None], u_z[np.maximum(idx, 0)], eye[2])
+        # Degenerate frames reuse the previous good frame's basis; camera axes
+        # before the first good frame of a sequence (METHOD_SPEC §3.8).
+        t = np.arange(len(ok))
+        idx = np.maximum.accumulate(np.where(ok, t, -1))
+        first = 0
+        if offsets is not None:
+            first = np.repeat(offsets, np.diff(offsets, append=len(ok)))
+        found = idx >= first
+        eye = np.eye(3)[:, :, None]
+        u_x = np.where(found, u_x[:, np.maximum(idx, 0)], eye[0])
+        u_z = np.where(found, u_z[:, np.maximum(idx, 0)], eye[2])
     return u_x, u_z
 
 
-def _angle(u, v, ok, fallback):
-    """Angle between unit vectors ``u`` and ``v``; ``fallback`` where not ``ok``."""
-    cos = np.clip(np.einsum("...i,...i->...", u, v), -1.0, 1.0)
-    return np.where(ok, np.arccos(cos), fallback)
+def _body_frame(P, torso, left_right, spine):
+    """:func:`_body_frame_planes` for ``(T, K, 3)`` joints; ``(T, 3)`` axes."""
+    u_x, u_z = _body_frame_planes(_planes(P), torso, left_right, spine)
+    return _points(u_x), _points(u_z)
 
 
-def _angles(P, triples, u_x, u_z):
-    """Inclination, azimuth and bending angles (METHOD_SPEC §3.9-3.11)."""
-    i, j, k = triples[:, 0], triples[:, 1], triples[:, 2]
-    pi, pj, pk = P[:, i], P[:, j], P[:, k]
-    a, ok_a = _unit(pi - pj)
-    c, ok_c = _unit(pk - pj)
-    inclination = _angle(a, c, ok_a & ok_c, DEGENERATE_INCLINATION)
+def _angles(S, triples, u_x, u_z, incl, azim, bend):
+    """Inclination, azimuth and bending angles (METHOD_SPEC §3.9-3.11).
 
-    b1 = -a  # (p_j - p_i) / |p_j - p_i|
-    b2 = pk - pj
-    b2p, ok_b2 = _unit(b2 - np.einsum("tki,tki->tk", b2, b1)[..., None] * b1)
-    ux = u_x[:, None, :]
-    up, ok_u = _unit(
-        ux - np.einsum("tki,tki->tk", np.broadcast_to(ux, b1.shape), b1)[..., None] * b1
-    )
-    azimuth = _angle(b2p, up, ok_a & ok_b2 & ok_u, 0.0)
+    ``S`` holds the joints as planes ``(3, K, n)``, ``u_x, u_z`` the body axes
+    ``(3, n)``; the angles are written into the rows of ``incl``, ``azim`` and
+    ``bend``.
+    """
+    i, j, k = triples.T
+    pj = S[:, j]
+    a = S[:, i]
+    a, ok_a = _unit(np.subtract(a, pj, out=a), out=a)  # first bone p_i - p_j
+    b2 = np.subtract(S[:, k], pj, out=pj)  # second bone p_k - p_j
+    c, ok_c = _unit(b2)
+    _arccos(_dot(a, c), ok_a & ok_c, DEGENERATE_INCLINATION, incl)
 
-    pos, ok_p = _unit(P)
-    bending = _angle(pos, u_z[:, None, :], ok_p, 0.0)
-    return inclination, azimuth, bending
+    # Projections onto the plane normal to the first bone b1 = -a (the signs of
+    # b1 cancel in (x . b1) b1).
+    b2 -= np.multiply(_dot(b2, a), a, out=c)
+    b2p, ok_b2 = _unit(b2, out=b2)
+    up = np.multiply(_dot(a, u_x[:, None]), a, out=c)
+    np.subtract(u_x[:, None], up, out=up)
+    up, ok_u = _unit(up, out=up)
+    _arccos(_dot(b2p, up), ok_a & ok_b2 & ok_u, 0.0, azim)
+
+    pos, ok_p = _unit(S)
+    _arccos(_dot(pos, u_z[:, None]), ok_p, 0.0, bend)
+
+
+def _standardise(rows, mean, scale):
+    """``(rows - mean) / scale`` in place, per row; nothing when ``mean`` is None."""
+    if mean is not None:
+        rows -= mean[:, None]
+        rows /= scale[:, None]
+
+
+def _pair_runs(pairs):
+    """Group joint pairs into runs ``(row, a, b_start, b_stop)`` of one first
+    joint ``a`` and consecutive second joints."""
+    runs = []
+    for row, (a, b) in enumerate(np.asarray(pairs).reshape(-1, 2).tolist()):
+        if runs and runs[-1][1] == a and runs[-1][3] == b:
+            runs[-1][3] += 1
+        else:
+            runs.append([row, a, b, b + 1])
+    return runs
+
+
+def _distances_planes(S, runs, out):
+    """Joint distances of the pair ``runs`` (METHOD_SPEC §3.12) into ``out`` rows.
+
+    ``S`` holds the joints as planes ``(3, K, n)``.
+    """
+    tmp = np.empty((max((hi - lo for _, _, lo, hi in runs), default=0),) + S.shape[2:])
+    for row, a, lo, hi in runs:
+        d, t = out[row : row + hi - lo], tmp[: hi - lo]
+        for c in range(N_COORDS):
+            np.subtract(S[c, lo:hi], S[c, a], out=t)
+            if c == 0:
+                np.multiply(t, t, out=d)
+            else:
+                d += np.multiply(t, t, out=t)
+        np.sqrt(d, out=d)
+    return out
 
 
 def _distances(P, pairs):
-    """Pairwise joint distances in lexicographic pair order (METHOD_SPEC §3.12).
+    """Pairwise joint distances of ``(T, K, 3)`` joints in ``pairs`` order."""
+    pairs = np.asarray(pairs).reshape(-1, 2)
+    out = np.empty((len(pairs), len(P)))
+    return _distances_planes(_planes(P), _pair_runs(pairs), out).T.copy()
 
-    Uses the Gram matrix (|a|^2 + |b|^2 - 2 a.b), about twice as fast as
-    gathering the 55 difference vectors.
-    """
-    T, J = P.shape[:2]
-    G = np.einsum("tic,tjc->tij", P, P).reshape(T, J * J)
-    sq = G[:, :: J + 1]
-    d2 = (
-        sq[:, pairs[:, 0]]
-        + sq[:, pairs[:, 1]]
-        - 2.0 * G[:, pairs[:, 0] * J + pairs[:, 1]]
-    )
-    return np.sqrt(np.maximum(d2, 0.0))
+
+def _feature_groups(dj):
+    """Row slices of the feature groups of the layout (METHOD_SPEC §3.13):
+    positions, velocities, accelerations, inclinations, azimuths, bendings and
+    distances."""
+    K, n_tri = dj.n_joints, len(dj.triples)
+    sizes = [3 * K, 3 * K, 3 * K, n_tri, n_tri, K, K * (K - 1) // 2]
+    ends = np.cumsum(sizes).tolist()
+    return [slice(end - size, end) for size, end in zip(sizes, ends)]
 
 
 class PoseDescriptor(TransformerMixin, BaseEstimator):
@@ -388,14 +651,15 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
             )
         allq = np.concatenate(filled)
         links = spec["links"]
-        self.link_lengths_ = _norm(allq[:, links[:, 1]] - allq[:, links[:, 0]]).mean(
-            axis=0
-        )
+        bones = _planes(allq[:, links[:, 1]] - allq[:, links[:, 0]])
+        self.link_lengths_ = _norm(bones).mean(axis=-1)
         self.n_features_out_ = spec["joints"].n_features
         self.mean_ = np.zeros(self.n_features_out_)
         self.scale_ = np.ones(self.n_features_out_)
         if self.standardize:
-            feats = np.concatenate([self._describe(X[i], spec) for i in valid_seq])
+            feats = np.concatenate(
+                self._describe_all([X[i] for i in valid_seq], spec, standardize=False)
+            )
             self.mean_ = feats.mean(axis=0)
             std = feats.std(axis=0)
             self.scale_ = np.where(std < MIN_SCALE, 1.0, std)
@@ -416,8 +680,7 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = self._validate(X, reset=False)
-        spec = self._spec()
-        return [(self._describe(seq, spec) - self.mean_) / self.scale_ for seq in X]
+        return self._describe_all(X, self._spec(), standardize=True)
 
     def get_feature_names_out(self, input_features=None):
         """Names of the descriptor features, in layout order.
@@ -457,22 +720,36 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         )
 
     def _spec(self):
-        """Joint, link, triple and pair indices for the chosen joint set."""
+        """Joint, link, triple and pair indices for the chosen joint set.
+
+        ``links`` are Kinect indices; ``used_links`` and ``used_keep`` index the
+        ``used`` joints (kept or on a link); triples, torso and pair runs index the
+        kept joints; ``groups`` are the row slices of the feature groups.
+        """
         dj = get_descriptor_joints(self.joints)
         idx = KINECT_V1.indices
         keep = np.asarray(idx(dj.joints))
+        links = np.asarray([idx(link) for link in dj.links], dtype=np.intp)
+        links = links.reshape(-1, 2)
         pos_in_keep = {k: n for n, k in enumerate(keep)}
+        # Joints the descriptor reads: the kept ones and those of the links.
+        used = np.union1d(keep, links)
+        pos_in_used = np.searchsorted(used, np.arange(KINECT_V1.n_joints))
         return {
             "joints": dj,
             "keep": keep,
-            "links": np.asarray([idx(link) for link in dj.links], dtype=np.intp),
+            "links": links,
             "triples": np.asarray(
                 [[pos_in_keep[k] for k in idx(t)] for t in dj.triples], dtype=np.intp
-            ),
+            ).reshape(-1, 3),
             "torso": np.asarray([pos_in_keep[k] for k in idx(dj.torso)]),
             "left_right": [pos_in_keep[k] for k in idx(dj.left_right)],
             "spine": [pos_in_keep[k] for k in idx(dj.spine)],
-            "pairs": np.asarray(dj.pairs, dtype=np.intp).reshape(-1, 2),
+            "pair_runs": _pair_runs(dj.pairs),
+            "groups": _feature_groups(dj),
+            "used": used,
+            "used_links": pos_in_used[links],
+            "used_keep": pos_in_used[keep],
         }
 
     def _prepare(self, seq):
@@ -486,40 +763,77 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
 
     def _describe(self, seq, spec):
         """Raw (unstandardised) descriptor of one sequence, ``(T, n_features)``."""
-        T = len(seq)
-        q, miss = self._prepare(seq)
-        if miss.all():
-            # No tracked frame: the standardised descriptor is all zeros.
-            return np.broadcast_to(self.mean_, (T, self.n_features_out_)).copy()
+        return self._describe_all([seq], spec, standardize=False)[0]
+
+    def _describe_all(self, X, spec, standardize):
+        """Descriptors of sequences ``X``, computed batch by batch."""
+        out = []
+        size = BATCH_VALUES // spec["joints"].n_features  # frames per batch
+        for batch in _batches([len(seq) for seq in X], size):
+            out += self._describe_batch([X[i] for i in batch], spec, standardize)
+        return out
+
+    def _describe_batch(self, X, spec, standardize):
+        """Descriptors of sequences ``X`` from one pass over their concatenation.
+
+        Returns one ``(T_i, n_features)`` array per sequence, standardised or raw
+        (C-contiguous views of one array).
+        """
+        lengths = np.array([len(seq) for seq in X])
+        Q, untracked = _sequence_planes(X, lengths, self.fill)
+        q = Q[:, spec["used"]]
+        q -= Q[:, KINECT_V1.index(KINECT_V1.root), None]
         if self.link_normalisation:
-            q = _link_normalise(
-                q, spec["links"], self.link_lengths_, self.link_direction
+            _link_normalise_planes(
+                q, spec["used_links"], self.link_lengths_, self.link_direction
             )
-        P = q[:, spec["keep"]]
-        if self.sigma > 0:
-            P = _smooth_time(P, gaussian_kernel(self.sigma), self.border)
-        Pp = _pad_time(P, 2, "replicate")
-        vel = Pp[3 : T + 3] - Pp[1 : T + 1]
-        acc = Pp[4 : T + 4] + Pp[0:T] - 2.0 * P
-        u_x, u_z = _body_frame(P, spec["torso"], spec["left_right"], spec["spine"])
-        incl, azim, bend = _angles(P, spec["triples"], u_x, u_z)
-        dist = _distances(P, spec["pairs"])
+        P = q[:, spec["used_keep"]].reshape(-1, q.shape[-1])  # (3 * K, frames)
+
+        offsets, n = _segment_offsets(lengths)
+        kernel = gaussian_kernel(self.sigma) if self.sigma > 0 else None
+        K = len(spec["keep"])
+        S = _smoothed(P, lengths, offsets, n, kernel, self.border)
+        S = S.reshape(N_COORDS, K, n)  # smoothed joints over the padded frames
+
+        # D holds the descriptor as feature rows over the padded frames. Each
+        # group of rows is standardised as soon as it is complete (in cache).
+        D = np.empty((spec["joints"].n_features, n))
+        pos, vel, acc, incl, azim, bend, dist = groups = [
+            D[rows] for rows in spec["groups"]
+        ]
+        if standardize:
+            stats = [(self.mean_[g], self.scale_[g]) for g in spec["groups"]]
+        else:
+            stats = [(None, None)] * len(groups)
+        pos_vel_acc = [  # joint-major rows, seen as coordinate planes
+            rows.reshape(K, N_COORDS, n).transpose(1, 0, 2) for rows in groups[:3]
+        ]
+        pos_vel_acc[0][...] = S
+        _standardise(pos, *stats[0])
+        _derivatives(S, *pos_vel_acc[1:])
+        _standardise(vel, *stats[1])
+        _standardise(acc, *stats[2])
+        u_x, u_z = _body_frame_planes(
+            S, spec["torso"], spec["left_right"], spec["spine"], offsets
+        )
+        _angles(S, spec["triples"], u_x, u_z, incl, azim, bend)
+        for rows, (mean, scale) in zip((incl, azim, bend), stats[3:6]):
+            _standardise(rows, mean, scale)
+        _distances_planes(S, spec["pair_runs"], dist)
         if self.distance_scale == "spine":
             lo, hi = spec["spine"]
-            spine = _norm(P[:, hi] - P[:, lo])[:, None]
-            dist = dist / np.where(spine > MIN_NORM, spine, 1.0)
-        return np.concatenate(
-            [
-                P.reshape(T, -1),
-                vel.reshape(T, -1),
-                acc.reshape(T, -1),
-                incl,
-                azim,
-                bend,
-                dist,
-            ],
-            axis=1,
-        )
+            spine = _norm(S[:, hi] - S[:, lo])
+            spine[~(spine > MIN_NORM)] = 1.0
+            dist /= spine
+        _standardise(dist, *stats[6])
+
+        Z = np.ascontiguousarray(D.T)  # frames as rows
+        out = []
+        for o, T, skip in zip(offsets + EDGE, lengths, untracked):
+            if skip:  # no tracked frame: the standardised descriptor is all zeros
+                Z[o : o + T] = 0.0 if standardize else self.mean_
+            out.append(Z[o : o + T])
+        return out
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
