@@ -31,6 +31,7 @@ bench: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check skgesture tests examples benchmarks
+	$(BIN)/ruff format --check skgesture tests examples benchmarks
 	$(BIN)/flake8 skgesture tests examples benchmarks
 
 clean:

@@ -192,8 +192,9 @@ class _BiLSTMModule(nn.Module):
     biases 0.
     """
 
-    def __init__(self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES,
-                 dropout=CPU_DROPOUT):
+    def __init__(
+        self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES, dropout=CPU_DROPOUT
+    ):
         super().__init__()
         self.lstms = nn.ModuleList()
         width = n_inputs
@@ -248,8 +249,9 @@ class _StepCrossEntropy(nn.Module):
 
     def forward(self, logits, target):
         flat = logits.reshape(-1, logits.shape[-1])
-        loss = F.cross_entropy(flat, target.reshape(-1), ignore_index=IGNORE_INDEX,
-                               reduction="sum")
+        loss = F.cross_entropy(
+            flat, target.reshape(-1), ignore_index=IGNORE_INDEX, reduction="sum"
+        )
         if self.time_reduction == "sum":
             return loss / target.shape[0]
         return loss / (target != IGNORE_INDEX).sum().clamp(min=1)
@@ -343,10 +345,14 @@ class _BiLSTMNet(BaseEstimator):
         )
         seed = seed_from(self.random_state)
         callbacks = [
-            ("lr_scheduler", LRScheduler(
-                policy=torch.optim.lr_scheduler.StepLR,
-                step_size=self.lr_drop_period, gamma=self.lr_drop_factor,
-            )),
+            (
+                "lr_scheduler",
+                LRScheduler(
+                    policy=torch.optim.lr_scheduler.StepLR,
+                    step_size=self.lr_drop_period,
+                    gamma=self.lr_drop_factor,
+                ),
+            ),
         ]
         train_split = None
         if self.early_stopping:
@@ -356,10 +362,17 @@ class _BiLSTMNet(BaseEstimator):
                     f"needs at least 2 training sequences, got {len(X)}"
                 )
             train_split = _SequenceHoldout(self.validation_fraction, seq, seed)
-            callbacks.append(("early_stopping", EarlyStopping(
-                monitor="valid_loss", patience=self.n_iter_no_change,
-                load_best=True, sink=print if self.verbose else _silent,
-            )))
+            callbacks.append(
+                (
+                    "early_stopping",
+                    EarlyStopping(
+                        monitor="valid_loss",
+                        patience=self.n_iter_no_change,
+                        load_best=True,
+                        sink=print if self.verbose else _silent,
+                    ),
+                )
+            )
         self.net_ = NeuralNet(
             _BiLSTMModule,
             module__n_inputs=Xw.shape[2],

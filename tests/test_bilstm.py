@@ -93,8 +93,9 @@ def toy_test():
 def fitted(toy):
     torch.set_num_threads(1)
     X, y = toy
-    return BiLSTMTagger(hidden_sizes=(16,), dropout=0.0, max_epochs=25,
-                        random_state=0).fit(X, y)
+    return BiLSTMTagger(
+        hidden_sizes=(16,), dropout=0.0, max_epochs=25, random_state=0
+    ).fit(X, y)
 
 
 # -- training windows ------------------------------------------------------------
@@ -116,8 +117,10 @@ def test_sample_windows_switches_step_with_window_content():
         sample_windows(y), [0, 5, 10, 15, 17, 19, 21, 23, 25, 27, 29, 31, 36]
     )
     # window 20: 0 (frames 0-19) is all rest -> 7; 7..28 touch the gesture -> +3
-    assert_array_equal(sample_windows(y, window=20, rest_step=7, gesture_step=3),
-                       [0, 7, 10, 13, 16, 19, 22, 25, 28])
+    assert_array_equal(
+        sample_windows(y, window=20, rest_step=7, gesture_step=3),
+        [0, 7, 10, 13, 16, 19, 22, 25, 28],
+    )
 
 
 def test_sample_windows_short_and_empty_sequences():
@@ -329,8 +332,10 @@ def test_same_seed_same_predictions(toy, toy_test):
     X, y = toy[0][:6], toy[1][:6]
     a = BiLSTMTagger(**TINY).fit(X, y).predict_proba(toy_test[0][:2])
     b = BiLSTMTagger(**TINY).fit(X, y).predict_proba(toy_test[0][:2])
-    c = BiLSTMTagger(**{**TINY, "random_state": 1}).fit(X, y).predict_proba(
-        toy_test[0][:2]
+    c = (
+        BiLSTMTagger(**{**TINY, "random_state": 1})
+        .fit(X, y)
+        .predict_proba(toy_test[0][:2])
     )
     for pa, pb, pc in zip(a, b, c):
         assert_array_equal(pa, pb)
@@ -403,8 +408,12 @@ def test_verbose_prints_epochs_only_when_asked(toy, capsys):
 
 def test_early_stopping_validates_on_held_out_sequences(toy):
     X, y = toy[0][:6], toy[1][:6]
-    tagger = BiLSTMTagger(**{**TINY, "max_epochs": 40}, early_stopping=True,
-                          n_iter_no_change=3, validation_fraction=0.2).fit(X, y)
+    tagger = BiLSTMTagger(
+        **{**TINY, "max_epochs": 40},
+        early_stopping=True,
+        n_iter_no_change=3,
+        validation_fraction=0.2,
+    ).fit(X, y)
     history = tagger.net_.history
     assert "valid_loss" in history[-1] and len(history) <= 40
     stopper = dict(tagger.net_.callbacks_)["early_stopping"]
@@ -444,7 +453,10 @@ def test_gpu_model_predicts_on_cpu(toy, tmp_path):
         f"print(t.predict([np.load({str(tmp_path / 'x0.npy')!r})])[0].tolist())"
     )
     out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True,
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
         env={**os.environ, "CUDA_VISIBLE_DEVICES": ""},
     ).stdout
     assert out.strip() == str(expected[0].tolist())
@@ -554,11 +566,18 @@ def test_pipeline_and_grid_search_over_min_run(tmp_path, monkeypatch):
         return original(self, X, y)
 
     monkeypatch.setattr(_BiLSTMNet, "fit", counting_fit)
-    pipe = Pipeline([
-        ("descriptor", PoseDescriptor()),
-        ("tagger", BiLSTMTagger(**{**TINY, "max_epochs": 3},
-                                memory=joblib.Memory(tmp_path, verbose=0))),
-    ])
+    pipe = Pipeline(
+        [
+            ("descriptor", PoseDescriptor()),
+            (
+                "tagger",
+                BiLSTMTagger(
+                    **{**TINY, "max_epochs": 3},
+                    memory=joblib.Memory(tmp_path, verbose=0),
+                ),
+            ),
+        ]
+    )
     pred = pipe.fit(X, y).predict(X[:1])
     assert pred[0].shape == y[0].shape
     assert set(np.unique(pred[0])) <= {0, 1, 2, 3}
