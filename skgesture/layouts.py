@@ -182,6 +182,8 @@ class DescriptorJoints:
         return 9 * j + 2 * t + j + j * (j - 1) // 2
 
 
+_UPPER_BODY = frozenset(KINECT_V1.joint_names[:13]) | {"HipRight"}  # no legs
+
 # The paper's 11 upper-body joints, METHOD_SPEC §3.1 (decision D1), the 13-link
 # upper-body tree of §3.5 and the 9 triples of §3.9 (decision D6).
 PAPER_11 = DescriptorJoints(
@@ -199,21 +201,11 @@ PAPER_11 = DescriptorJoints(
         "HipLeft",
         "HipRight",
     ),  # fmt: skip
-    links=(
-        ("HipCenter", "Spine"),
-        ("Spine", "ShoulderCenter"),
-        ("ShoulderCenter", "Head"),
-        ("ShoulderCenter", "ShoulderLeft"),
-        ("ShoulderLeft", "ElbowLeft"),
-        ("ElbowLeft", "WristLeft"),
-        ("WristLeft", "HandLeft"),
-        ("ShoulderCenter", "ShoulderRight"),
-        ("ShoulderRight", "ElbowRight"),
-        ("ElbowRight", "WristRight"),
-        ("WristRight", "HandRight"),
-        ("HipCenter", "HipRight"),
-        ("HipCenter", "HipLeft"),
-    ),  # fmt: skip
+    # The 13-link upper-body tree: every Kinect bone between upper-body joints.
+    links=tuple(
+        (a, b) for a, b in KINECT_V1.bones if a in _UPPER_BODY and b in _UPPER_BODY
+    ),
+    # fmt: skip
     triples=(
         ("HipCenter", "ShoulderCenter", "Head"),
         ("HipCenter", "ShoulderCenter", "ShoulderLeft"),

@@ -75,6 +75,8 @@ MEDIAPIPE_POSE_LANDMARKS = (
     "left_heel", "right_heel", "left_foot_index", "right_foot_index",
 )  # fmt: skip
 
+_LIMB_PARTS = ("Shoulder", "Elbow", "Wrist", "Hand", "Hip", "Knee", "Ankle", "Foot")
+
 # Each Kinect v1 joint is the mean of these source joints (in KINECT_V1 order).
 _KINECT_V2_SOURCES = {
     "HipCenter": ("SpineBase",),
@@ -84,16 +86,7 @@ _KINECT_V2_SOURCES = {
     **{
         f"{part}{side}": (f"{part}{side}",)
         for side in ("Left", "Right")
-        for part in (
-            "Shoulder",
-            "Elbow",
-            "Wrist",
-            "Hand",
-            "Hip",
-            "Knee",
-            "Ankle",
-            "Foot",
-        )
+        for part in _LIMB_PARTS
     },
 }
 _AZURE_KINECT_SOURCES = {
@@ -104,16 +97,7 @@ _AZURE_KINECT_SOURCES = {
     **{
         f"{part}{side.title()}": (f"{part.upper()}_{side}",)
         for side in ("LEFT", "RIGHT")
-        for part in (
-            "Shoulder",
-            "Elbow",
-            "Wrist",
-            "Hand",
-            "Hip",
-            "Knee",
-            "Ankle",
-            "Foot",
-        )
+        for part in _LIMB_PARTS
     },
 }
 _MEDIAPIPE_SOURCES = {
