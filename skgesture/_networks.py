@@ -379,5 +379,5 @@ def fit_inner_estimator(estimator, default, X, y, *, rng, memory):
     """
     est = clone(default if estimator is None else estimator)
     if rng is not None and "random_state" in est.get_params():
-        est.set_params(random_state=int(rng.randint(np.iinfo(np.int32).max)))
+        est.set_params(random_state=seed_from(rng))
     return fit_cached(memory, est, X, y)
