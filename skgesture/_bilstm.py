@@ -2,7 +2,6 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from contextlib import contextmanager
 from numbers import Integral, Real
 
 import numpy as np
@@ -15,7 +14,7 @@ from skorch.callbacks import EarlyStopping, LRScheduler
 from torch import nn
 from torch.nn import functional as F
 
-from skgesture._networks import fit_cached, seed_from
+from skgesture._networks import fit_cached, seed_from, torch_threads
 from skgesture.utils._segments import labels_to_segments, remove_short_runs
 from skgesture.utils._smoothing import loess_smooth
 from skgesture.utils._validation import check_sequence_labels, check_sequences
@@ -122,20 +121,6 @@ def _training_windows(X, y, window, rest_step, gesture_step):
         yw.append(ys)
         seq.append(np.full(len(xs), i, dtype=np.int64))
     return np.concatenate(Xw), np.concatenate(yw), np.concatenate(seq)
-
-
-@contextmanager
-def _torch_threads(n_threads):
-    """Run the block with ``n_threads`` torch intra-op threads (``None``: as is)."""
-    if n_threads is None:
-        yield
-        return
-    before = torch.get_num_threads()
-    torch.set_num_threads(n_threads)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(before)
 
 
 def _chunks(n_frames, window, overlap):
@@ -730,7 +715,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
             random_state=random_state,
             verbose=self.verbose,
         )
-        with _torch_threads(self.n_threads):
+        with torch_threads(self.n_threads):
             fitted = fit_cached(self.memory, network, X, y_idx)
         self.classes_ = classes
         self.net_ = fitted.net_
@@ -752,7 +737,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = check_sequences(X, ndim=2, estimator=self, reset=False)
-        with _torch_threads(self.n_threads):
+        with torch_threads(self.n_threads):
             return _predict_chunks(
                 self.net_.module_, X, self.window, self.overlap, len(self.classes_)
             )

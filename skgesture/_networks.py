@@ -10,6 +10,7 @@ minimum lengths) can be searched by ``GridSearchCV`` without retraining (DESIGN.
 # SPDX-License-Identifier: BSD-3-Clause
 
 import copy
+from contextlib import contextmanager
 
 import numpy as np
 import torch
@@ -21,7 +22,14 @@ from skorch.callbacks import Callback, EpochTimer, PrintLog
 from skorch.dataset import Dataset
 from torch import nn
 
-__all__ = ["MLPModule", "build_net", "fit_cached", "predict_module", "seed_from"]
+__all__ = [
+    "MLPModule",
+    "build_net",
+    "fit_cached",
+    "predict_module",
+    "seed_from",
+    "torch_threads",
+]
 
 # MATLAB trainscg defaults, METHOD_SPEC §8.6.1
 SCG_MAX_FAIL = 6
@@ -296,6 +304,25 @@ def build_net(
         **{f"module__{k}": v for k, v in module_params.items()},
         **{f"optimizer__{k}": v for k, v in opt_kwargs.items()},
     )
+
+
+@contextmanager
+def torch_threads(n_threads):
+    """Run the block with ``n_threads`` torch intra-op threads (``None``: as is).
+
+    The thread policy of every torch estimator in skgesture: tiny networks run
+    fastest, and never oversubscribe a busy machine, on one intra-op thread.
+    The previous setting is restored on exit.
+    """
+    if n_threads is None:
+        yield
+        return
+    before = torch.get_num_threads()
+    torch.set_num_threads(n_threads)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def _fit_clone(estimator, X, y):

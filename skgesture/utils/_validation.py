@@ -11,7 +11,12 @@ import numbers
 
 import numpy as np
 
-__all__ = ["check_sequences", "check_sequence_labels", "missing_frames"]
+__all__ = [
+    "check_sequences",
+    "check_sequence_labels",
+    "missing_frames",
+    "untracked_rows",
+]
 
 
 def _describe(obj):
@@ -248,6 +253,40 @@ def missing_frames(seq):
     """
     flat = np.asarray(seq, dtype=float).reshape(len(seq), -1)
     return np.isnan(flat).any(axis=1) | ~np.any(flat != 0, axis=1)
+
+
+def untracked_rows(x):
+    """Boolean mask of the untracked frames of one sequence, raw or described.
+
+    The toolkit-wide rule is that an untracked frame is rest, in every model and
+    in streaming. A described sequence carries its untracked frames as the
+    masked rows of a ``numpy.ma.MaskedArray``; a raw one as all-zero or NaN
+    frames.
+
+    Parameters
+    ----------
+    x : ndarray or MaskedArray of shape (n_frames, ...)
+        One sequence.
+
+    Returns
+    -------
+    ndarray of bool of shape (n_frames,)
+        True where the frame is untracked.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.utils._validation import untracked_rows
+    >>> feats = np.ma.masked_array(np.ones((3, 2)), mask=[[0, 0], [1, 1], [0, 0]])
+    >>> untracked_rows(feats).tolist()
+    [False, True, False]
+    >>> untracked_rows(np.zeros((2, 20, 3))).tolist()
+    [True, True]
+    """
+    if isinstance(x, np.ma.MaskedArray):
+        mask = np.ma.getmaskarray(x)
+        return mask.reshape(len(mask), -1).any(axis=1)
+    return missing_frames(x)
 
 
 def check_positive_int(value, name):
