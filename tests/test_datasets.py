@@ -5,6 +5,7 @@ data (counted there independently of this code), or are recomputed here from the
 raw text with plain Python.
 """
 
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from skgesture.datasets import (
     CHALEARN_GESTURE_NAMES,
     MSR_ACTION3D_TO_KINECT_V1,
     DataFileWarning,
+    DataFormatError,
     load_chalearn,
     load_msr_action3d,
     load_msrc12,
@@ -294,7 +296,7 @@ def test_writer_clamps_to_the_sequence(tmp_path):
     # per-frame labels longer than numFrames are cut at numFrames
     with pytest.warns(DataFileWarning, match="beyond numFrames=4"):
         (path,) = write_chalearn_predictions(
-            [np.array([0, 2, 2, 2, 2, 2])], [701], tmp_path, n_frames=4
+            [np.array([0, 2, 2, 2, 2, 2])], [701], tmp_path, n_frames=4, overwrite=True
         )
     assert path.read_text() == "2,2,4\n"
 
@@ -827,3 +829,189 @@ def test_msr_action3d_broken_files(tmp_path):
     with pytest.warns(DataFileWarning, match="1 clip\\(s\\) .* absent: a02_s01_e01"):
         data = load_msr_action3d(tmp_path)
     assert data.sample_ids == ["a01_s01_e01"] and data.X[0].shape == (1, 20, 3)
+
+
+# ============================================================================
+# Hardening: bounded by the data present, clear errors (issue 11)
+# ============================================================================
+
+
+def _raises_format_error(call, file, line, match):
+    """``call()`` raises DataFormatError naming ``file`` and ``line``."""
+    with pytest.raises(DataFormatError, match=match) as info:
+        call()
+    assert info.value.file == file and info.value.line == line
+    assert file in str(info.value)
+    return info.value
+
+
+@pytest.mark.parametrize("n_frames", ["1000000000", "1208000", "27"])
+def test_chalearn_num_frames_far_from_skeleton_raises(tmp_path, n_frames):
+    # 1e9 used to ask for 1.3 TiB and 1,208,000 to pad 6 frames to 2.4 GB.
+    _raises_format_error(
+        lambda: load_chalearn(_sample(tmp_path, data=f"{n_frames},20,4095\n")),
+        "Sample0001_data.csv",
+        1,
+        f"numFrames {n_frames} disagrees with the 6 lines of Sample0001_skeleton.csv "
+        f"by more than 20 frames",
+    )
+
+
+def test_chalearn_num_frames_tolerance_is_20_frames_or_5_percent(tmp_path):
+    skeleton = (FRAME + "\n") * 500  # 5 % of 500 = 25 frames
+    with pytest.warns(DataFileWarning, match="padded with 25 missing"):
+        data = load_chalearn(
+            _sample(tmp_path / "a", skeleton=skeleton, data="525,20,4095\n")
+        )
+    assert data.X[0].shape == (525, 20, 3)
+    with pytest.raises(DataFormatError, match="by more than 25 frames"):
+        load_chalearn(_sample(tmp_path / "b", skeleton=skeleton, data="526,20,4095\n"))
+    with pytest.warns(DataFileWarning, match="padded with 20 missing"):
+        load_chalearn(_sample(tmp_path / "c", data="26,20,4095\n"))
+
+
+def test_chalearn_labels_only_num_frames_is_bounded(tmp_path):
+    for name, text in (("labels", "3,2,4\n"), ("data", "1000000000,20,4095\n")):
+        (tmp_path / f"Sample0001_{name}.csv").write_text(text)
+    _raises_format_error(
+        lambda: load_chalearn(tmp_path),
+        "Sample0001_data.csv",
+        1,
+        "numFrames 1000000000 is more than a day at 20 fps",
+    )
+    (tmp_path / "Sample0001_data.csv").write_text("1208,20,4095\n")
+    with pytest.warns(DataFileWarning, match="numFrames 1208 is far beyond the last"):
+        data = load_chalearn(tmp_path)
+    assert data.n_frames.tolist() == [1208] and len(data.y[0]) == 1208
+    (tmp_path / "Sample0001_data.csv").write_text("608,20,4095\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_chalearn(tmp_path)  # within 2 x 4 + 600: no warning
+
+
+@pytest.mark.parametrize(
+    "token, match",
+    [
+        ("inf", "value 2 \\('inf'\\) is not a finite number"),
+        ("-inf", "value 2 \\('-inf'\\) is not a finite number"),
+        ("nan", "value 2 \\('nan'\\) is not a finite number"),
+        ("1e999", "value 2 \\('1e999'\\) is not a finite number"),
+        ("2e4", "world coordinate 20000 is beyond \\+-10000 m"),
+    ],
+)
+def test_chalearn_skeleton_non_finite_or_absurd_values(tmp_path, token, match):
+    bad = FRAME.replace("0.5", token, 2).replace(token, "0.5", 1)
+    skeleton = (FRAME + "\n") * 2 + bad + "\n" + (FRAME + "\n") * 3
+    _raises_format_error(
+        lambda: load_chalearn(_sample(tmp_path, skeleton=skeleton)),
+        "Sample0001_skeleton.csv",
+        3,
+        match,
+    )
+
+
+@pytest.mark.parametrize("value", ["99999999999999999999", "-9223372036854775809"])
+def test_labels_beyond_int64_raise_format_error(tmp_path, value):
+    # used to raise a bare OverflowError
+    _raises_format_error(
+        lambda: load_chalearn(_sample(tmp_path, labels=f"3,2,4\n3,{value},5\n")),
+        "Sample0001_labels.csv",
+        2,
+        "value 2 .* is beyond the 64-bit integer range",
+    )
+
+
+def test_utkinect_huge_frame_number_raises(tmp_path):
+    row = " ".join(["0.5"] * 60)
+    (tmp_path / "joints_s01_e01.txt").write_text(f"10 {row}\n1e19 {row}\n")
+    (tmp_path / "actionLabel.txt").write_text("s01_e01\nwalk: 10 14\n")
+    # used to wrap to -9.2e18 silently
+    _raises_format_error(
+        lambda: load_utkinect(tmp_path),
+        "joints_s01_e01.txt",
+        2,
+        "frame number 1e\\+19 is not an integer of at most 2\\*\\*53",
+    )
+
+
+def test_msrc12_huge_timestamp_and_tick_raise(tmp_path):
+    row = " ".join(["0.5 0.5 2.5 1"] * 20)
+    (tmp_path / "P3_1_2_p03.csv").write_text(f"0 {row}\n1e19 {row}\n")
+    (tmp_path / "P3_1_2_p03.tagstream").write_text("XQPCTick;Tag\n12;G2 Duck\n")
+    _raises_format_error(
+        lambda: load_msrc12(tmp_path),
+        "P3_1_2_p03.csv",
+        2,
+        "timestamp 1e\\+19 is not an integer",
+    )
+    (tmp_path / "P3_1_2_p03.csv").write_text(f"0 {row}\n33333 {row}\n")
+    (tmp_path / "P3_1_2_p03.tagstream").write_text(
+        "XQPCTick;Tag\n99999999999999999999;G2 Duck\n"
+    )
+    _raises_format_error(
+        lambda: load_msrc12(tmp_path), "P3_1_2_p03.tagstream", 2, "beyond 2\\*\\*53"
+    )
+
+
+def test_precog_and_msr_refuse_infinite_positions(tmp_path):
+    header = "; ".join(KINECT_V1.joint_names)
+    frame = "; ".join(["0.1 0.2 2.5"] * 20) + "; 0"
+    (tmp_path / "Seq1_1.csv").write_text(
+        f"{header}\n{frame}\n{frame.replace('2.5', 'inf', 1)}\n"
+    )
+    _raises_format_error(
+        lambda: load_precog(tmp_path), "Seq1_1.csv", 3, "value 3 \\('inf'\\)"
+    )
+    line = "0.1 0.2 2.5 1\n"
+    (tmp_path / "a01_s01_e01_skeleton3D.txt").write_text(line * 5 + "1e300 0 0 1\n")
+    _raises_format_error(
+        lambda: load_msr_action3d(tmp_path, subset="all"),
+        "a01_s01_e01_skeleton3D.txt",
+        6,
+        "coordinate 1e\\+300 is beyond",
+    )
+
+
+def test_data_format_error_is_a_value_error_and_pickles():
+    import pickle
+
+    exc = DataFormatError("a.csv line 3: bad", file="a.csv", line=3)
+    assert isinstance(exc, ValueError)
+    back = pickle.loads(pickle.dumps(exc))
+    assert (type(back), str(back), back.file, back.line) == (
+        DataFormatError,
+        "a.csv line 3: bad",
+        "a.csv",
+        3,
+    )
+
+
+def test_writer_refuses_to_overwrite_unless_asked(tmp_path):
+    (first,) = write_chalearn_predictions([np.array([0, 3, 3])], [701], tmp_path)
+    with pytest.raises(FileExistsError, match="Sample0701_prediction.csv"):
+        write_chalearn_predictions([np.array([0, 5, 5])], [701], tmp_path)
+    assert first.read_text() == "3,2,3\n"  # untouched
+    write_chalearn_predictions([np.array([0, 5, 5])], [701], tmp_path, overwrite=True)
+    assert first.read_text() == "5,2,3\n"
+    # nothing is written when any of the files exists
+    with pytest.raises(FileExistsError, match="Sample0701_prediction.csv"):
+        write_chalearn_predictions([[0], [0]], [702, 701], tmp_path)
+    assert not (tmp_path / "Sample0702_prediction.csv").exists()
+
+
+def test_writer_output_path_is_a_file(tmp_path):
+    (tmp_path / "results").write_text("not a folder")
+    with pytest.raises(NotADirectoryError, match="'.*results' is an existing file"):
+        write_chalearn_predictions([[0]], [701], tmp_path / "results")
+    with pytest.raises(NotADirectoryError, match="is an existing file"):
+        write_chalearn_predictions([[0]], [701], tmp_path / "results" / "sub")
+
+
+def test_loaders_show_progress_only_when_verbose(shared_data, capsys):
+    folder = _chalearn_dir(shared_data, "v2_2014_validation_labels")
+    load_chalearn(folder, samples=[471, 472])
+    assert capsys.readouterr().err == ""
+    load_chalearn(folder, samples=[471, 472], verbose=1)
+    assert "ChaLearn samples" in capsys.readouterr().err
+    load_msr_action3d(shared_data / "msr_action3d", verbose=1)
+    assert "MSR Action3D clips" in capsys.readouterr().err

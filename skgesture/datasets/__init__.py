@@ -11,7 +11,7 @@ names class ``k``), ``layout`` (``"kinect_v1"``) and ``DESCR``.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from skgesture.datasets._base import DataFileWarning
+from skgesture.datasets._base import DataFileWarning, DataFormatError
 from skgesture.datasets._chalearn import (
     CHALEARN_GESTURE_NAMES,
     load_chalearn,
@@ -28,11 +28,18 @@ from skgesture.datasets._others import (
     load_utkinect,
 )
 from skgesture.datasets._precog import PRECOG_ACTION_NAMES, load_precog
+from skgesture.datasets._recordings import (
+    load_recordings,
+    read_intervals,
+    read_skeleton_csv,
+    write_intervals,
+)
 from skgesture.datasets._synthetic import make_gesture_streams
 
 __all__ = [
     "CHALEARN_GESTURE_NAMES",
     "DataFileWarning",
+    "DataFormatError",
     "MSRC12_GESTURE_NAMES",
     "MSR_ACTION3D_ACTION_NAMES",
     "MSR_ACTION3D_TO_KINECT_V1",
@@ -42,8 +49,12 @@ __all__ = [
     "load_msr_action3d",
     "load_msrc12",
     "load_precog",
+    "load_recordings",
     "load_utkinect",
     "make_gesture_streams",
     "read_chalearn_labels",
+    "read_intervals",
+    "read_skeleton_csv",
     "write_chalearn_predictions",
+    "write_intervals",
 ]

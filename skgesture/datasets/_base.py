@@ -23,11 +23,83 @@ from skgesture.layouts import KINECT_V1, N_COORDS, N_KINECT_JOINTS
 from skgesture.utils._segments import segments_to_labels
 from skgesture.utils._validation import missing_frames
 
-__all__ = ["DataFileWarning"]
+__all__ = ["DataFileWarning", "DataFormatError"]
 
 LAYOUT_NAME = KINECT_V1.name  # the ``layout`` value of every Bunch
 FRAME_SHAPE = (N_KINECT_JOINTS, N_COORDS)  # one frame of ``X``
 SEGMENT_COLUMNS = 3  # (class, start, end)
+# Positions beyond 10 km cannot come from a skeleton tracker: the file is corrupt.
+# (The real data of every loader stays within 5 m of the sensor.)
+MAX_ABS_COORDINATE = 1e4
+MAX_EXACT_INTEGER = 2**53  # float64 holds every integer up to this exactly
+
+
+class DataFormatError(ValueError):
+    """A data file is malformed: wrong columns, not numbers, out-of-range values.
+
+    Every loader of :mod:`skgesture.datasets` raises it for a file it cannot
+    read safely, with a message that names the file and, where it makes sense,
+    the 1-based line. It is a :class:`ValueError`, so ``except ValueError`` keeps
+    working.
+
+    Parameters
+    ----------
+    message : str
+        The full message (it already names the file and the line).
+    file : str or None, default=None
+        Name of the offending file (e.g. ``"Sample0001_skeleton.csv"``).
+    line : int or None, default=None
+        1-based line of the problem in ``file``, None when it is not about one
+        line.
+
+    Attributes
+    ----------
+    file : str or None
+        Name of the offending file.
+    line : int or None
+        1-based line, or None.
+
+    See Also
+    --------
+    DataFileWarning : For readable but unusual files.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from skgesture.datasets import DataFormatError, read_chalearn_labels
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "Sample0001_labels.csv"
+    >>> _ = path.write_text("3,2,6\\n5,7\\n")
+    >>> try:
+    ...     read_chalearn_labels(path)
+    ... except DataFormatError as exc:
+    ...     print(exc.file, exc.line, "|", exc)
+    Sample0001_labels.csv 2 | Sample0001_labels.csv line 2: expected 3 values, got 2
+    >>> tmp.cleanup()
+    """
+
+    def __init__(self, message, *, file=None, line=None):
+        super().__init__(message)
+        self.file = file
+        self.line = line
+
+    def __reduce__(self):
+        return (_rebuild_error, (type(self), self.args, self.file, self.line))
+
+
+def _rebuild_error(cls, args, file, line):
+    """Unpickle a :class:`DataFormatError` (keyword-only attributes)."""
+    return cls(*args, file=file, line=line)
+
+
+def _format_error(name, line, message):
+    """A :class:`DataFormatError` worded ``"{name} line {line}: {message}"``.
+
+    ``line=None`` gives ``"{name}: {message}"``.
+    """
+    where = name if line is None else f"{name} line {line}"
+    return DataFormatError(f"{where}: {message}", file=name, line=line)
 
 
 class DataFileWarning(UserWarning):
@@ -70,9 +142,11 @@ def _decode(data, name):
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise ValueError(
-            f"{name} line {line}: not a text file (byte {data[exc.start]:#04x} at "
-            f"offset {exc.start} is not valid UTF-8)"
+        raise _format_error(
+            name,
+            line,
+            f"not a text file (byte {data[exc.start]:#04x} at offset {exc.start} is "
+            f"not valid UTF-8)",
         ) from None
 
 
@@ -94,7 +168,16 @@ def _lines(text):
     return lines
 
 
-def _parse_table(lines, n_values, name, *, sep=None, dtype=np.float64, first_line=1):
+def _parse_table(
+    lines,
+    n_values,
+    name,
+    *,
+    sep=None,
+    dtype=np.float64,
+    first_line=1,
+    allow_nan=False,
+):
     """Parse lines of ``n_values`` separated numbers into a 2-D array.
 
     Parameters
@@ -111,6 +194,9 @@ def _parse_table(lines, n_values, name, *, sep=None, dtype=np.float64, first_lin
         ``np.float64`` or ``np.int64``.
     first_line : int, default=1
         1-based file line number of ``lines[0]`` (for error messages).
+    allow_nan : bool, default=False
+        Accept ``nan`` tokens (float tables only). Infinite values (``inf``, or
+        a number beyond the float64 range such as ``1e999``) are always refused.
 
     Returns
     -------
@@ -119,8 +205,10 @@ def _parse_table(lines, n_values, name, *, sep=None, dtype=np.float64, first_lin
 
     Raises
     ------
-    ValueError
-        Naming the file and the 1-based line of the first bad line.
+    DataFormatError
+        Naming the file and the 1-based line of the first bad line: a wrong
+        number of values, a value that is not a number (an integer for
+        ``np.int64``), beyond the int64 range, or not finite.
     """
     rows = [ln.split(sep) for ln in lines]
     lengths = np.fromiter(map(len, rows), dtype=np.int64, count=len(rows))
@@ -130,34 +218,117 @@ def _parse_table(lines, n_values, name, *, sep=None, dtype=np.float64, first_lin
         got = int(lengths[i])
         if sep is not None and not lines[i].strip():
             got = 0
-        raise ValueError(
-            f"{name} line {i + first_line}: expected {n_values} values, got {got}"
-            + (" (empty line)" if got == 0 else "")
+        raise _format_error(
+            name,
+            i + first_line,
+            f"expected {n_values} values, got {got}"
+            + (" (empty line)" if got == 0 else ""),
         )
     if not rows:
         return np.zeros((0, n_values), dtype=dtype)
     try:
-        return np.array(rows, dtype=dtype)
-    except ValueError:
-        pass
-    convert = int if np.dtype(dtype).kind == "i" else float
-    kind = "an integer" if convert is int else "a number"
+        values = np.array(rows, dtype=dtype)
+    except (ValueError, OverflowError):
+        values = None
+    if values is not None and values.dtype.kind == "f":
+        bad = ~np.isfinite(values)
+        if allow_nan:
+            bad &= ~np.isnan(values)
+        if not bad.any():
+            return values
+    elif values is not None:
+        return values
+    _raise_first_bad_value(rows, name, first_line, dtype, allow_nan)
+    raise DataFormatError(f"{name}: could not be parsed", file=name)  # pragma: no cover
+
+
+def _raise_first_bad_value(rows, name, first_line, dtype, allow_nan):
+    """Raise the :class:`DataFormatError` of the first unparsable or bad value."""
+    integer = np.dtype(dtype).kind == "i"
+    int64 = np.iinfo(np.int64)
     for i, row in enumerate(rows):
         for j, value in enumerate(row):
+            where = f"value {j + 1} ({value.strip()[:40]!r})"
             try:
-                convert(value)
+                number = int(value) if integer else float(value)
             except ValueError:
-                raise ValueError(
-                    f"{name} line {i + first_line}: value {j + 1} ({value.strip()!r}) "
-                    f"is not {kind}"
+                kind = "an integer" if integer else "a number"
+                raise _format_error(
+                    name, i + first_line, f"{where} is not {kind}"
                 ) from None
-    raise ValueError(f"{name}: could not be parsed")  # pragma: no cover
+            if integer and not int64.min <= number <= int64.max:
+                raise _format_error(
+                    name, i + first_line, f"{where} is beyond the 64-bit integer range"
+                )
+            if not integer and not (
+                np.isfinite(number) or (allow_nan and np.isnan(number))
+            ):
+                raise _format_error(
+                    name,
+                    i + first_line,
+                    f"{where} is not a finite number (infinite, NaN, or beyond the "
+                    f"float64 range)",
+                )
+
+
+def _check_magnitude(values, name, *, first_line=1, columns=None, what="coordinate"):
+    """Raise when a position is beyond :data:`MAX_ABS_COORDINATE` (a corrupt file).
+
+    Parameters
+    ----------
+    values : ndarray of shape (n_lines, n_values)
+        Parsed table; row ``i`` is file line ``i + first_line``.
+    name : str
+        File name used in the message.
+    first_line : int, default=1
+        1-based file line of ``values[0]``.
+    columns : slice, index array or None, default=None
+        The columns holding positions (None: all).
+    what : str, default="coordinate"
+        What the value is, for the message.
+    """
+    block = values if columns is None else values[:, columns]
+    big = np.abs(block) > MAX_ABS_COORDINATE
+    if big.any():
+        i, j = np.argwhere(big)[0]
+        raise _format_error(
+            name,
+            int(i) + first_line,
+            f"{what} {block[i, j]:g} is beyond +-{MAX_ABS_COORDINATE:g} m; skeleton "
+            f"positions are metres from the sensor, so the file is corrupt",
+        )
+
+
+def _integer_column(column, name, *, first_line=1, what="value"):
+    """Exact int64 copy of a float column of integers (raises naming the line).
+
+    Refuses non-integers and magnitudes beyond 2**53, the largest integers that
+    float64 (the parsed values) holds exactly, instead of wrapping.
+    """
+    bad = (column != np.round(column)) | (np.abs(column) > MAX_EXACT_INTEGER)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise _format_error(
+            name,
+            i + first_line,
+            f"{what} {column[i]:g} is not an integer of at most 2**53 in magnitude",
+        )
+    return column.astype(np.int64)
+
+
+def _progress(iterable, *, verbose, desc, total=None):
+    """``iterable`` wrapped in a tqdm bar when ``verbose >= 1`` (else unchanged)."""
+    if not verbose:
+        return iterable
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, desc=desc, total=total, unit="file", leave=False)
 
 
 def _require_lines(lines, name, what="data"):
     """Raise a clear ValueError when a file holds no non-blank line."""
     if not lines:
-        raise ValueError(f"{name} is empty: expected {what}")
+        raise DataFormatError(f"{name} is empty: expected {what}", file=name)
 
 
 def _sort_and_label(segments, n_frames):

@@ -16,13 +16,17 @@ from pathlib import Path
 import numpy as np
 
 from skgesture.datasets._base import (
+    DataFormatError,
+    _check_magnitude,
     _check_path,
     _decode,
     _descr,
     _empty_segments,
+    _format_error,
     _lines,
     _make_bunch,
     _parse_table,
+    _progress,
     _read_text,
     _require_lines,
     _sort_and_label,
@@ -51,8 +55,24 @@ VALUES_PER_JOINT = 9  # Wx, Wy, Wz, 4 rotation, Px, Py (METHOD_SPEC §1.4)
 N_SKELETON_COLUMNS = N_KINECT_JOINTS * VALUES_PER_JOINT  # 180
 N_LABEL_COLUMNS = 3  # class, start, end (METHOD_SPEC §1.5)
 N_DATA_COLUMNS = 3  # numFrames, fps, maxDepth (METHOD_SPEC §1.3)
+# numFrames may differ from the skeleton's line count by this much (the skeleton
+# is then padded with missing frames or truncated, with a warning); beyond it the
+# two files disagree too much to trust either and loading stops. Every real
+# sample has exactly numFrames lines.
+FRAME_MISMATCH_FRAMES = 20  # one second at 20 fps ...
+FRAME_MISMATCH_FRACTION = 0.05  # ... or 5 % of the skeleton, whichever is larger
+# Without a skeleton (labels only) numFrames cannot be checked against data:
+# a day at 20 fps is refused as corrupt, and a numFrames far beyond the last
+# labelled frame (over 2 x last end + 30 s; the 230 validation samples stay
+# within 1.33 x and 339 frames) is used with a warning.
+MAX_LABELS_ONLY_FRAMES = 24 * 3600 * 20
+TRAILING_REST_FRAMES = 600
 
 _KINDS = ("skeleton", "labels", "data")
+# Columns of the world positions Wx, Wy, Wz of every joint in a skeleton line.
+_WORLD_COLUMNS = (
+    np.arange(N_KINECT_JOINTS)[:, None] * VALUES_PER_JOINT + np.arange(N_COORDS)
+).ravel()
 _FILE_RE = re.compile(r"^(Sample\d{4,5})_(skeleton|labels|data)\.csv$")
 _ZIP_RE = re.compile(r"^(Sample\d{4,5})\.zip$")
 _DIR_RE = re.compile(r"^Sample\d{4,5}$")
@@ -104,8 +124,10 @@ def _format_sample_id(sample_id):
 def _open_zip(path):
     try:
         return zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise ValueError(f"{path.name} is not a valid zip file ({exc})") from None
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+        raise DataFormatError(
+            f"{path.name} is not a valid zip file ({exc})", file=path.name
+        ) from None
 
 
 def _zip_members(path):
@@ -145,8 +167,9 @@ def _discover(path):
             for (sid, kind), member in _zip_members(path).items():
                 sources.setdefault(sid, {})[kind] = ("zip", path, member)
             if not sources:
-                raise ValueError(
-                    f"{path.name} holds no SampleXXXX_skeleton/labels/data.csv file"
+                raise DataFormatError(
+                    f"{path.name} holds no SampleXXXX_skeleton/labels/data.csv file",
+                    file=path.name,
                 )
         elif fmatch:
             _scan_folder(path.parent, sources, prefer=True)
@@ -189,8 +212,12 @@ def _source_lines(src):
     try:
         with _open_zip(src[1]) as zf:
             data = zf.read(src[2])
-    except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as exc:
-        raise ValueError(f"{_source_name(src)}: corrupt zip member ({exc})") from None
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError) as exc:
+        if isinstance(exc, DataFormatError):
+            raise
+        raise _format_error(
+            _source_name(src), None, f"corrupt zip member ({exc})"
+        ) from None
     return _lines(_decode(data, _source_name(src)))
 
 
@@ -206,12 +233,13 @@ def _parse_data(lines, name):
         lines[-1:], N_DATA_COLUMNS, name, sep=",", first_line=len(lines)
     )[0]
     if n_frames != int(n_frames) or n_frames < 1:
-        raise ValueError(
-            f"{name} line {len(lines)}: numFrames must be a positive integer, got "
-            f"{n_frames:g}"
+        raise _format_error(
+            name,
+            len(lines),
+            f"numFrames must be a positive integer, got {n_frames:g}",
         )
     if not fps > 0:
-        raise ValueError(f"{name} line {len(lines)}: fps must be > 0, got {fps:g}")
+        raise _format_error(name, len(lines), f"fps must be > 0, got {fps:g}")
     return int(n_frames), float(fps), float(max_depth)
 
 
@@ -237,7 +265,7 @@ def _parse_labels(lines, name, n_frames=None):
             why = f"start frame {s} is after end frame {e}"
         else:
             why = f"end frame {e} is beyond the last frame {n_frames}"
-        raise ValueError(f"{name} line {i + 1}: {why} (line {lines[i].strip()!r})")
+        raise _format_error(name, i + 1, f"{why} (line {lines[i].strip()!r})")
     return np.stack([cls, start - 1, end], axis=1)
 
 
@@ -288,11 +316,30 @@ def read_chalearn_labels(file, *, n_frames=None):
     return _parse_labels(_lines(_read_text(path)), path.name, n_frames)
 
 
-def _parse_skeleton(lines, name, n_frames):
-    """``(T, 180)`` skeleton values, padded/truncated to ``n_frames`` (warns)."""
+def _parse_skeleton(lines, name, n_frames, data_where=None):
+    """``(T, 180)`` skeleton values, padded/truncated to ``n_frames`` (warns).
+
+    ``data_where`` is ``(file name, line)`` of numFrames, named in the error
+    when the skeleton and numFrames disagree beyond the tolerance.
+    """
     _require_lines(lines, name, f"one line of {N_SKELETON_COLUMNS} values per frame")
     skel = _parse_table(lines, N_SKELETON_COLUMNS, name, sep=",")
+    _check_magnitude(skel, name, columns=_WORLD_COLUMNS, what="world coordinate")
     if n_frames is not None and len(skel) != n_frames:
+        tolerance = max(
+            FRAME_MISMATCH_FRAMES, int(np.ceil(FRAME_MISMATCH_FRACTION * len(skel)))
+        )
+        if abs(n_frames - len(skel)) > tolerance:
+            data_name, data_line = data_where or ("the data file", None)
+            raise _format_error(
+                data_name,
+                data_line,
+                f"numFrames {n_frames} disagrees with the {len(skel)} lines of "
+                f"{name} by more than {tolerance} frames (the tolerance: "
+                f"{FRAME_MISMATCH_FRAMES} frames or "
+                f"{FRAME_MISMATCH_FRACTION:.0%} of the skeleton); one of the two "
+                f"files is corrupt",
+            )
         if len(skel) > n_frames:
             _warn(
                 f"{name} has {len(skel)} frames but the data file says {n_frames}; "
@@ -312,10 +359,17 @@ def _parse_skeleton(lines, name, n_frames):
 def _load_sample(sid, src, *, labels_only):
     """Read one sample; returns a dict with skel, segments, y, n_frames, fps..."""
     out = {"has_labels": "labels" in src}
+    data_where = None
     if "data" in src:
-        n_frames, fps, max_depth = _parse_data(
-            _source_lines(src["data"]), _source_name(src["data"])
-        )
+        data_lines = _source_lines(src["data"])
+        data_where = (_source_name(src["data"]), len(data_lines))
+        n_frames, fps, max_depth = _parse_data(data_lines, data_where[0])
+        if labels_only and n_frames > MAX_LABELS_ONLY_FRAMES:
+            raise _format_error(
+                *data_where,
+                f"numFrames {n_frames} is more than a day at 20 fps "
+                f"({MAX_LABELS_ONLY_FRAMES}); the file is corrupt",
+            )
     elif labels_only:
         raise FileNotFoundError(
             f"{sid}: no {sid}_data.csv, which is needed to know the number of "
@@ -326,7 +380,10 @@ def _load_sample(sid, src, *, labels_only):
     skel = None
     if not labels_only:
         skel = _parse_skeleton(
-            _source_lines(src["skeleton"]), _source_name(src["skeleton"]), n_frames
+            _source_lines(src["skeleton"]),
+            _source_name(src["skeleton"]),
+            n_frames,
+            data_where,
         )
         if n_frames is None:
             n_frames = len(skel)
@@ -337,6 +394,13 @@ def _load_sample(sid, src, *, labels_only):
     if "labels" in src:
         name = _source_name(src["labels"])
         raw = _parse_labels(_source_lines(src["labels"]), name, n_frames)
+        last = int(raw[:, 2].max()) if len(raw) else 0
+        if labels_only and last and n_frames > 2 * last + TRAILING_REST_FRAMES:
+            _warn(
+                f"{data_where[0]}: numFrames {n_frames} is far beyond the last "
+                f"labelled frame {last} of {name}; it is used as given (check the "
+                f"data file)"
+            )
         seg, y, overlaps = _sort_and_label(raw, n_frames)
         if overlaps:
             pairs = "; ".join(
@@ -375,7 +439,9 @@ def _select_samples(sources, samples, path):
     return [by_number[n] for n in dict.fromkeys(wanted)]
 
 
-def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=None):
+def load_chalearn(
+    path, *, return_joint_data=False, labels_only=False, samples=None, verbose=0
+):
     """Load ChaLearn LAP 2014 Track 3 (Montalbano) samples.
 
     Reads ``SampleXXXX.zip`` archives (only their skeleton, labels and data CSV
@@ -398,6 +464,8 @@ def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=N
         validation ground-truth folders).
     samples : list of (str or int) or None, default=None
         Only these samples, e.g. ``["Sample0101", 470]``.
+    verbose : int, default=0
+        0 is silent; 1 shows a tqdm progress bar over the samples.
 
     Returns
     -------
@@ -440,17 +508,23 @@ def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=N
     FileNotFoundError
         If ``path`` does not exist, holds no sample, or a requested sample is
         absent.
-    ValueError
+    DataFormatError
         For a corrupt, truncated or wrongly shaped file, naming the file and the
-        1-based line; for a bad zip; for a folder mixing samples with and
-        without skeleton (pass ``labels_only=True`` or ``samples``).
+        1-based line: a value that is not a finite number, a world position
+        beyond 10 km, a bad zip, or a numFrames that disagrees with the number
+        of skeleton lines by more than 20 frames or 5 % (see Notes).
+        It is a :class:`ValueError`.
+    ValueError
+        For a folder mixing samples with and without skeleton (pass
+        ``labels_only=True`` or ``samples``).
 
     Warns
     -----
     DataFileWarning
-        When a skeleton has more or fewer lines than numFrames (truncated or
-        padded with missing frames, METHOD_SPEC §1.4) or labels overlap (kept in
-        ``segments``; in ``y`` the later gesture wins).
+        When a skeleton has a few more or fewer lines than numFrames (truncated
+        or padded with missing frames, METHOD_SPEC §1.4), when labels overlap
+        (kept in ``segments``; in ``y`` the later gesture wins), or, labels
+        only, when numFrames lies far beyond the last labelled frame.
 
     See Also
     --------
@@ -462,6 +536,16 @@ def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=N
     ``_data.csv`` is read from its last line, as the official scorer does. A
     sample without data file takes numFrames from its skeleton and fps 20, with
     a warning.
+
+    numFrames is bounded by the data present, so that a corrupt data file
+    cannot make the loader allocate gigabytes: with a skeleton, it may differ
+    from the number of skeleton lines by at most 20 frames or 5 % of them
+    (whichever is larger; the skeleton is then padded with missing frames or
+    truncated, with a warning), and a larger difference raises
+    :class:`DataFormatError` naming the data file. Every real sample has
+    exactly numFrames lines. With labels only, numFrames above a day at 20 fps
+    (1,728,000) raises, and one above twice the last labelled frame plus 600
+    frames is used with a warning.
 
     References
     ----------
@@ -507,7 +591,10 @@ def load_chalearn(path, *, return_joint_data=False, labels_only=False, samples=N
                 f"labels_only: no labels file for {', '.join(unlabelled[:5])}"
                 f"{', ...' if len(unlabelled) > 5 else ''}"
             )
-    loaded = [_load_sample(s, sources[s], labels_only=labels_only) for s in ids]
+    loaded = [
+        _load_sample(s, sources[s], labels_only=labels_only)
+        for s in _progress(ids, verbose=verbose, desc="ChaLearn samples")
+    ]
     X = joint_data = None
     if not labels_only:
         blocks = [
@@ -611,7 +698,9 @@ def _as_prediction_segments(pred, sid, n_frames):
     return out[np.argsort(out[:, 1], kind="stable")]
 
 
-def write_chalearn_predictions(predictions, sample_ids, folder, *, n_frames=None):
+def write_chalearn_predictions(
+    predictions, sample_ids, folder, *, n_frames=None, overwrite=False
+):
     """Write one official ``SampleXXXX_prediction.csv`` file per sequence.
 
     Each file has one ``class,start,end`` line per predicted gesture (1-based,
@@ -633,6 +722,9 @@ def write_chalearn_predictions(predictions, sample_ids, folder, *, n_frames=None
         Number of frames (numFrames) of each sequence (e.g. ``data.n_frames``). Frames
         are clamped to ``1 <= start <= end <= numFrames`` (METHOD_SPEC §2.2); without it
         only ``start >= 1`` is enforced (and labels past it are dropped).
+    overwrite : bool, default=False
+        Replace prediction files that already exist in ``folder``. By default
+        an existing one raises :class:`FileExistsError` and nothing is written.
 
     Returns
     -------
@@ -644,6 +736,11 @@ def write_chalearn_predictions(predictions, sample_ids, folder, *, n_frames=None
     ValueError
         If a class is outside 1..20 (per-frame labels outside 0..20), naming the
         sample and the row or frame: nothing is silently written for it.
+    FileExistsError
+        If ``overwrite=False`` and a ``SampleXXXX_prediction.csv`` to write
+        already exists (it names the file; nothing is written).
+    NotADirectoryError
+        If ``folder`` (or a folder above it) is an existing file.
 
     Warns
     -----
@@ -695,10 +792,26 @@ def write_chalearn_predictions(predictions, sample_ids, folder, *, n_frames=None
             raise ValueError(f"{sid}: n_frames must be a positive integer, got {n}")
         rows.append(_as_prediction_segments(pred, sid, None if n is None else int(n)))
     out_dir = Path(folder).expanduser()
+    for parent in (out_dir, *out_dir.parents):
+        if parent.exists() and not parent.is_dir():
+            raise NotADirectoryError(
+                f"output folder {str(out_dir)!r}: {str(parent)!r} is an existing "
+                f"file, not a folder; give a folder for the prediction files"
+            )
+    paths = [out_dir / f"{sid}_prediction.csv" for sid in names]
+    folders = [p for p in paths if p.is_dir()]
+    if folders:
+        raise IsADirectoryError(f"{str(folders[0])!r} is a folder, expected a file")
+    if not overwrite:
+        existing = [p for p in paths if p.exists()]
+        if existing:
+            raise FileExistsError(
+                f"{str(existing[0])!r} already exists"
+                + (f" (and {len(existing) - 1} more)" if len(existing) > 1 else "")
+                + "; pass overwrite=True to replace prediction files, or write to "
+                "an empty folder"
+            )
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for sid, seg in zip(names, rows):
-        path = out_dir / f"{sid}_prediction.csv"
+    for path, seg in zip(paths, rows):
         path.write_text("".join(f"{c},{s},{e}\n" for c, s, e in seg.tolist()))
-        paths.append(path)
     return paths

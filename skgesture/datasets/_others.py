@@ -12,13 +12,19 @@ import re
 import numpy as np
 
 from skgesture.datasets._base import (
+    MAX_EXACT_INTEGER,
+    DataFormatError,
+    _check_magnitude,
     _descr,
     _empty_segments,
     _find_dir,
     _flag_all_zero,
+    _format_error,
+    _integer_column,
     _lines,
     _make_bunch,
     _parse_table,
+    _progress,
     _read_text,
     _require_lines,
     _sort_and_label,
@@ -51,7 +57,14 @@ MSRC12_N_VALUES = 1 + N_KINECT_JOINTS * MSRC12_VALUES_PER_JOINT  # timestamp + 8
 # Official loader: t_us = (tick * 1000 + TICKS_PER_MS / 2) / TICKS_PER_MS.
 MSRC12_TICKS_PER_MS = 49875
 _MSRC12_FILE_RE = re.compile(r"^P(\d+)_(\d+)_(\d+)_p(\d+)\.csv$")
-_MSRC12_TAG_RE = re.compile(r"^G(\d+)\s+\S")
+_MSRC12_TAG_RE = re.compile(r"^G([0-9]+)\s+\S")
+_MSRC12_TICK_RE = re.compile(r"^[0-9]+$")
+# Columns of x, y, z of every joint in a MSRC-12 line (after the timestamp).
+_MSRC12_XYZ = (
+    1
+    + np.arange(N_KINECT_JOINTS)[:, None] * MSRC12_VALUES_PER_JOINT
+    + np.arange(N_COORDS)
+).ravel()
 _MSRC12_HEADER = "XQPCTick;Tag"
 
 _MSRC12_DESCR = """
@@ -72,24 +85,30 @@ def _parse_tagstream(text, name):
     lines = _lines(text)
     _require_lines(lines, name, f"a header line {_MSRC12_HEADER!r}")
     if lines[0].strip() != _MSRC12_HEADER:
-        raise ValueError(
-            f"{name} line 1: expected the header {_MSRC12_HEADER!r}, got "
-            f"{lines[0].strip()[:40]!r}"
+        raise _format_error(
+            name,
+            1,
+            f"expected the header {_MSRC12_HEADER!r}, got {lines[0].strip()[:40]!r}",
         )
     ticks, classes = [], []
     for i, line in enumerate(lines[1:], start=2):
         tick, sep, tag = line.partition(";")
         match = _MSRC12_TAG_RE.match(tag.strip())
-        if not sep or not tick.strip().isdigit() or match is None:
-            raise ValueError(
-                f"{name} line {i}: expected 'tick;Gk gesture name', got "
-                f"{line.strip()[:60]!r}"
+        if not sep or not _MSRC12_TICK_RE.match(tick.strip()) or match is None:
+            raise _format_error(
+                name, i, f"expected 'tick;Gk gesture name', got {line.strip()[:60]!r}"
+            )
+        if int(tick) > MAX_EXACT_INTEGER:
+            raise _format_error(
+                name, i, f"tick {tick.strip()[:40]} is beyond 2**53; corrupt file"
             )
         cls = int(match.group(1))
         if not 1 <= cls <= len(MSRC12_GESTURE_NAMES):
-            raise ValueError(
-                f"{name} line {i}: gesture G{cls} is outside "
-                f"G1..G{len(MSRC12_GESTURE_NAMES)}"
+            raise _format_error(
+                name,
+                i,
+                f"gesture G{match.group(1)[:20]} is outside "
+                f"G1..G{len(MSRC12_GESTURE_NAMES)}",
             )
         ticks.append(int(tick))
         classes.append(cls)
@@ -104,7 +123,7 @@ def _action_point_frames(ticks, timestamps):
     return np.abs(timestamps[None, :] - t_us[:, None]).argmin(axis=1).astype(np.int64)
 
 
-def load_msrc12(path):
+def load_msrc12(path, *, verbose=0):
     """Load (a subset of) the MSRC-12 Kinect gesture dataset.
 
     Continuous 30 Hz streams, each with about 10 repetitions of one of 12
@@ -115,6 +134,8 @@ def load_msrc12(path):
     path : str or path-like
         Folder with the ``P*_*_*_pNN.csv`` skeleton files and their
         ``.tagstream`` files (or the folder holding its ``data`` subfolder).
+    verbose : int, default=0
+        0 is silent; 1 shows a tqdm progress bar over the files.
 
     Returns
     -------
@@ -133,8 +154,10 @@ def load_msrc12(path):
     ------
     FileNotFoundError
         If ``path`` does not exist or holds no skeleton file.
-    ValueError
-        For a malformed file, naming the file and the 1-based line.
+    DataFormatError
+        For a malformed file, naming the file and the 1-based line: wrong
+        number of values, a value that is not a finite number, a timestamp
+        that is not an integer of at most 2**53, a position beyond 10 km.
 
     Warns
     -----
@@ -186,14 +209,17 @@ def load_msrc12(path):
             files.append((subject, gesture, entry.stem, entry))
     files.sort(key=lambda f: f[:3])
     X, timestamps, points, classes = [], [], [], []
-    for subject, gesture, stem, file in files:
+    for subject, gesture, stem, file in _progress(
+        files, verbose=verbose, desc="MSRC-12 files"
+    ):
         lines = _lines(_read_text(file))
         _require_lines(lines, file.name, f"{MSRC12_N_VALUES} values per line")
         values = _parse_table(lines, MSRC12_N_VALUES, file.name)
         ts = values[:, 0]
+        _check_magnitude(values, file.name, columns=_MSRC12_XYZ)
         joints = values[:, 1:].reshape(len(values), N_KINECT_JOINTS, -1)
         X.append(np.ascontiguousarray(joints[:, :, :N_COORDS]))
-        timestamps.append(ts.astype(np.int64))
+        timestamps.append(_integer_column(ts, file.name, what="timestamp"))
         tag_file = file.with_suffix(".tagstream")
         if tag_file.is_file():
             ticks, cls = _parse_tagstream(_read_text(tag_file), tag_file.name)
@@ -270,20 +296,21 @@ def _parse_utk_labels(text, name):
             continue
         if _UTK_BLOCK_RE.match(line):
             if line in blocks:
-                raise ValueError(f"{name} line {i}: sequence {line} appears twice")
+                raise _format_error(name, i, f"sequence {line} appears twice")
             current = blocks[line] = {}
             continue
         match = _UTK_LINE_RE.match(line)
         if current is None or match is None:
-            raise ValueError(
-                f"{name} line {i}: expected 'sXX_eYY' or 'action: start end', got "
-                f"{line[:60]!r}"
+            raise _format_error(
+                name, i, f"expected 'sXX_eYY' or 'action: start end', got {line[:60]!r}"
             )
         action, start, end = match.groups()
         if action not in UTKINECT_ACTION_NAMES:
-            raise ValueError(
-                f"{name} line {i}: unknown action {action!r}; expected one of "
-                f"{', '.join(UTKINECT_ACTION_NAMES)}"
+            raise _format_error(
+                name,
+                i,
+                f"unknown action {action[:40]!r}; expected one of "
+                f"{', '.join(UTKINECT_ACTION_NAMES)}",
             )
         if start == "NaN" and end == "NaN":
             current[action] = None
@@ -291,19 +318,21 @@ def _parse_utk_labels(text, name):
         try:
             s, e = float(start), float(end)
         except ValueError:
-            raise ValueError(
-                f"{name} line {i}: start/end must be numbers or 'NaN NaN', got "
-                f"{start!r} {end!r}"
+            raise _format_error(
+                name,
+                i,
+                f"start/end must be numbers or 'NaN NaN', got {start[:40]!r} "
+                f"{end[:40]!r}",
             ) from None
         if not (np.isfinite(s) and np.isfinite(e)) or s > e:
-            raise ValueError(
-                f"{name} line {i}: start {start} is after end {end} or not finite"
+            raise _format_error(
+                name, i, f"start {start[:40]} is after end {end[:40]} or not finite"
             )
         current[action] = (UTKINECT_ACTION_NAMES.index(action) + 1, s, e)
     return blocks
 
 
-def load_utkinect(path, *, labels="original"):
+def load_utkinect(path, *, labels="original", verbose=0):
     """Load the UTKinect-Action3D skeletons with their action intervals.
 
     Continuous streams of 10 whole-body actions in a fixed order; the start/end
@@ -317,6 +346,8 @@ def load_utkinect(path, *, labels="original"):
     labels : {"original", "alt"}, default="original"
         Which label file: ``actionLabel.txt`` or the second public copy
         ``actionLabel_alt_kvega005.txt`` (7 differences, see the data notes).
+    verbose : int, default=0
+        0 is silent; 1 shows a tqdm progress bar over the files.
 
     Returns
     -------
@@ -334,9 +365,13 @@ def load_utkinect(path, *, labels="original"):
     ------
     FileNotFoundError
         If ``path``, the joints files or the label file do not exist.
+    DataFormatError
+        For a malformed file (naming the file and the 1-based line: wrong
+        number of values, a value that is not a finite number, a frame number
+        that is not an integer of at most 2**53 or goes backwards, a position
+        beyond 10 km) or a sequence without labels.
     ValueError
-        For a malformed file (naming the file and the 1-based line), a sequence
-        without labels, or an unknown ``labels`` value.
+        For an unknown ``labels`` value.
 
     Warns
     -----
@@ -394,25 +429,31 @@ def load_utkinect(path, *, labels="original"):
     files.sort(key=lambda f: f[:2])
     X, y, segments, frames, fps, sample_ids = [], [], [], [], [], []
     overlaps = []
-    for subject, take, file in files:
+    for subject, take, file in _progress(files, verbose=verbose, desc="UTKinect files"):
         sid = f"s{subject:02d}_e{take:02d}"
         lines = _lines(_read_text(file))
         _require_lines(lines, file.name, f"{UTKINECT_N_VALUES} values per line")
         values = _parse_table(lines, UTKINECT_N_VALUES, file.name)
         number = values[:, 0]
         step = np.diff(number)
-        if np.any(number != np.round(number)) or np.any(step < 0):
-            i = int(
-                np.flatnonzero(
-                    np.r_[number != np.round(number)] | np.r_[False, step < 0]
-                )[0]
+        bad = (
+            (number != np.round(number))
+            | (np.abs(number) > MAX_EXACT_INTEGER)
+            | np.r_[False, step < 0]
+        )
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise _format_error(
+                file.name,
+                i + 1,
+                f"frame number {number[i]:g} is not an integer of at most 2**53 or "
+                f"goes backwards",
             )
-            raise ValueError(
-                f"{file.name} line {i + 1}: frame number {number[i]:g} is not an "
-                f"integer or goes backwards"
-            )
+        _check_magnitude(values, file.name, columns=slice(1, None))
         if sid not in blocks:
-            raise ValueError(f"{label_file.name} has no labels for {sid}")
+            raise DataFormatError(
+                f"{label_file.name} has no labels for {sid}", file=label_file.name
+            )
         rows, spans = [], []
         for action in UTKINECT_ACTION_NAMES:
             entry = blocks[sid].get(action)
@@ -433,7 +474,7 @@ def load_utkinect(path, *, labels="original"):
         X.append(values[:, 1:].reshape(len(values), N_KINECT_JOINTS, N_COORDS))
         y.append(lab)
         segments.append(seg)
-        frames.append(number.astype(np.int64))
+        frames.append(_integer_column(number, file.name, what="frame number"))
         span = number[-1] - number[0]
         fps.append(UTKINECT_VIDEO_FPS * (len(number) - 1) / span if span else np.nan)
         sample_ids.append(sid)
@@ -511,19 +552,21 @@ def _parse_msr_clip(text, name):
     lines = _lines(text)
     _require_lines(lines, name, f"{N_KINECT_JOINTS} lines of 4 values per frame")
     values = _parse_table(lines, MSR_ACTION3D_VALUES, name)
+    _check_magnitude(values, name, columns=slice(0, N_COORDS))
     if len(values) % N_KINECT_JOINTS:
         complete = len(values) // N_KINECT_JOINTS
-        raise ValueError(
-            f"{name} line {complete * N_KINECT_JOINTS + 1}: incomplete last frame "
-            f"({len(values)} lines is not a multiple of {N_KINECT_JOINTS}, one line "
-            f"per joint)"
+        raise _format_error(
+            name,
+            complete * N_KINECT_JOINTS + 1,
+            f"incomplete last frame ({len(values)} lines is not a multiple of "
+            f"{N_KINECT_JOINTS}, one line per joint)",
         )
     frames = values.reshape(-1, N_KINECT_JOINTS, MSR_ACTION3D_VALUES)
     frames = frames[:, MSR_ACTION3D_TO_KINECT_V1]
     return np.ascontiguousarray(frames[:, :, :N_COORDS]), frames[:, :, N_COORDS]
 
 
-def load_msr_action3d(path, *, subset="cvpr12"):
+def load_msr_action3d(path, *, subset="cvpr12", verbose=0):
     """Load the MSR Action3D skeleton clips (isolated actions).
 
     Each clip is one pre-segmented action; its joints are reordered from the MSR
@@ -538,6 +581,8 @@ def load_msr_action3d(path, *, subset="cvpr12"):
         ``"cvpr12"``: the clips listed in ``files_used_in_cvpr12_paper.txt`` (557,
         the usual protocol, which leaves out the corrupt ones); ``"all"``: every
         clip (567).
+    verbose : int, default=0
+        0 is silent; 1 shows a tqdm progress bar over the clips.
 
     Returns
     -------
@@ -556,9 +601,12 @@ def load_msr_action3d(path, *, subset="cvpr12"):
     FileNotFoundError
         If ``path`` or its clips do not exist, or ``subset="cvpr12"`` and the
         list file is absent.
+    DataFormatError
+        For a malformed clip, naming the file and the 1-based line (wrong
+        number of values, a value that is not a finite number, a position
+        beyond 10 km, an incomplete last frame).
     ValueError
-        For a malformed clip (naming the file and the 1-based line) or an
-        unknown ``subset``.
+        For an unknown ``subset``.
 
     Warns
     -----
@@ -615,10 +663,13 @@ def load_msr_action3d(path, *, subset="cvpr12"):
         clips = {c: clips[c] for c in listed if c in clips}
     order = sorted(clips, key=lambda c: clips[c][0])
     X, confidence, y, segments = [], [], [], []
-    for clip in order:
+    for clip in _progress(order, verbose=verbose, desc="MSR Action3D clips"):
         (action, _, _), file = clips[clip]
         if not 1 <= action <= len(MSR_ACTION3D_ACTION_NAMES):
-            raise ValueError(f"{file.name}: action a{action:02d} is outside a01..a20")
+            raise DataFormatError(
+                f"{file.name}: action a{action:02d} is outside a01..a20",
+                file=file.name,
+            )
         x, conf = _parse_msr_clip(_read_text(file), file.name)
         X.append(x)
         confidence.append(conf)

@@ -20,13 +20,17 @@ import re
 import numpy as np
 
 from skgesture.datasets._base import (
+    DataFormatError,
+    _check_magnitude,
     _check_path,
     _descr,
     _find_dir,
     _flag_all_zero,
+    _format_error,
     _lines,
     _make_bunch,
     _parse_table,
+    _progress,
     _read_text,
     _require_lines,
 )
@@ -70,34 +74,40 @@ def _parse_precog(text, name):
     _require_lines(lines, name, "a header line of 20 joint names")
     header = tuple(h.strip() for h in lines[0].split(FIELD_SEP))
     if header != KINECT_V1.joint_names:
-        raise ValueError(
-            f"{name} line 1: expected the header of the 20 Kinect v1 joint names "
-            f"separated by '; ' ({'; '.join(KINECT_V1.joint_names[:3])}; ...), got "
-            f"{lines[0][:80]!r}"
+        raise _format_error(
+            name,
+            1,
+            f"expected the header of the 20 Kinect v1 joint names separated by "
+            f"'; ' ({'; '.join(KINECT_V1.joint_names[:3])}; ...), got "
+            f"{lines[0][:80]!r}",
         )
     body = lines[1:]
     if not body:
-        raise ValueError(f"{name} has a header but no frame line")
+        raise DataFormatError(f"{name} has a header but no frame line", file=name)
     n_sep = np.fromiter((ln.count(FIELD_SEP) for ln in body), np.int64, len(body))
     bad = np.flatnonzero(n_sep != N_FIELDS - 1)
     if bad.size:
         i = int(bad[0])
-        raise ValueError(
-            f"{name} line {i + 2}: expected {N_FIELDS} ';'-separated fields (20 "
-            f"joints 'x y z' and a label), got {n_sep[i] + 1}"
+        raise _format_error(
+            name,
+            i + 2,
+            f"expected {N_FIELDS} ';'-separated fields (20 joints 'x y z' and a "
+            f"label), got {n_sep[i] + 1}",
         )
     values = _parse_table(
         [ln.replace(FIELD_SEP, " ") for ln in body], N_VALUES, name, first_line=2
     )
+    _check_magnitude(values, name, first_line=2, columns=slice(0, -1))
     label = values[:, -1]
     bad = np.flatnonzero(
         (label != np.round(label)) | (label < 0) | (label > N_PRECOG_CLASSES)
     )
     if bad.size:
         i = int(bad[0])
-        raise ValueError(
-            f"{name} line {i + 2}: label {label[i]:g} is not an integer in "
-            f"0..{N_PRECOG_CLASSES}"
+        raise _format_error(
+            name,
+            i + 2,
+            f"label {label[i]:g} is not an integer in 0..{N_PRECOG_CLASSES}",
         )
     X = values[:, :-1].reshape(len(values), N_KINECT_JOINTS, N_COORDS)
     return np.ascontiguousarray(X), label.astype(np.int64)
@@ -154,7 +164,10 @@ def _read_bundle(file):
     """``[(script, subject, X, y)]`` from a bundle file or file object."""
     with np.load(file, allow_pickle=False) as npz:
         if str(npz["format"]) != _BUNDLE_FORMAT:
-            raise ValueError(f"{BUNDLE_FILE}: unknown bundle format {npz['format']}")
+            raise DataFormatError(
+                f"{BUNDLE_FILE}: unknown bundle format {npz['format']}",
+                file=BUNDLE_FILE,
+            )
         n_frames = npz["n_frames"]
         flat = _unpack_positions(npz["positions"], int(n_frames.sum()))
         labels = npz["labels"].astype(np.int64)
@@ -176,7 +189,7 @@ def _bundle_bytes():
     return resource.read_bytes()
 
 
-def load_precog(path=None, *, subjects=None):
+def load_precog(path=None, *, subjects=None, verbose=0):
     """Load the PRECOG 2016 continuous action dataset.
 
     Kinect v1 streams of one subject performing 5 punches and kicks, with a label
@@ -190,6 +203,9 @@ def load_precog(path=None, *, subjects=None):
         ``CSV`` subfolder, or one file). ``None`` reads the bundled copy.
     subjects : list of int or None, default=None
         Only the sequences of these subjects.
+    verbose : int, default=0
+        0 is silent; 1 shows a tqdm progress bar over the files read (only
+        with ``path``: the bundle is one file).
 
     Returns
     -------
@@ -206,9 +222,12 @@ def load_precog(path=None, *, subjects=None):
     ------
     FileNotFoundError
         If ``path`` does not exist or holds no ``SeqA_B.csv`` file.
+    DataFormatError
+        For a malformed file, naming the file and 1-based line (wrong header or
+        fields, a value that is not a finite number, a position beyond 10 km, a
+        label outside 0..8).
     ValueError
-        For a malformed file (naming the file and 1-based line), or when a
-        requested subject is absent.
+        When a requested subject is absent.
 
     Warns
     -----
@@ -247,7 +266,10 @@ def load_precog(path=None, *, subjects=None):
         descr_title = "PRECOG 2016 (bundled: subjects 1-8)"
     else:
         records = []
-        for script, subject, file in _list_files(path):
+        files = _list_files(path)
+        for script, subject, file in _progress(
+            files, verbose=verbose, desc="PRECOG files"
+        ):
             X, y = _parse_precog(_read_text(file), file.name)
             records.append((script, subject, X, y))
         descr_title = "PRECOG 2016"
