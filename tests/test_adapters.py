@@ -331,6 +331,36 @@ def test_adapter_errors_and_lookup():
     assert {get_adapter(n).n_joints for n in ("kinect_v2", "azure_kinect")} == {25, 32}
 
 
+@pytest.mark.parametrize(
+    "adapter", [KinectV1Adapter(), KinectV2Adapter(), AzureKinectAdapter(),
+                MediaPipePoseAdapter(), MSRAction3DAdapter()],
+    ids=lambda a: a.name,
+)  # fmt: skip
+def test_adapters_refuse_what_is_not_an_array_of_numbers(adapter):
+    name = type(adapter).__name__
+    for bad in ("frame.csv", b"bytes", None, {"head": 1}):
+        with pytest.raises(TypeError, match=rf"{name} input must be an array .*got"):
+            adapter(bad)
+    with pytest.raises(ValueError, match=rf"{name} input .* of real numbers"):
+        adapter(np.full((adapter.n_joints, 3), "x"))
+    with pytest.raises(ValueError, match="real numbers"):
+        adapter(np.zeros((adapter.n_joints, 3)) + 1j)
+
+
+def test_replay_source_refuses_bad_arguments():
+    X = np.zeros((4, 20, 3))
+    with pytest.raises(TypeError, match="ReplaySource X must be an array"):
+        ReplaySource("recording.txt")
+    with pytest.raises(TypeError, match="adapter must be a SkeletonAdapter"):
+        ReplaySource(X, adapter=3)
+    with pytest.raises(ValueError, match="unknown layout"):
+        ReplaySource(X, adapter="openpose")
+    with pytest.raises(ValueError, match="fps"):
+        ReplaySource(X, fps="fast")
+    with pytest.raises(ValueError, match="unknown layout"):
+        get_adapter(["kinect_v2"])
+
+
 def test_replay_source_adapts_and_paces_frames(utk):
     x = utk.X[0][:6]
     now = [0.0]

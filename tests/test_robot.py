@@ -181,3 +181,56 @@ def test_commander_drives_the_robot_from_events():
     ignored = [d.reason for d, r in log if not d.issued]
     assert ignored == ["confidence 0.30 < 0.5"] and robot.state is RobotState.HOME
     assert [r.frame for r in robot.log] == [50, 60, 100, 150, 200, 260]
+
+
+@pytest.mark.parametrize("confidence", [float("nan"), float("inf"), -float("inf")])
+@pytest.mark.parametrize("floor", [0.0, 0.5, 1.0])
+def test_a_non_finite_confidence_never_issues_a_command(confidence, floor):
+    amap = ActionMap({1: "move_to_tool"}, min_confidence=floor)
+    decision = amap.decide(_event(1, 80, confidence=confidence))
+    assert not decision.issued
+    assert decision.reason == f"confidence {confidence!r} is not a finite number"
+    assert amap.decide(_event(1, 81, confidence=1.0)).issued  # nothing else changed
+
+
+def test_action_map_takes_class_names():
+    names = ["wave", "point", "grab"]
+    amap = ActionMap({"point": "close_gripper", 3: "carry_tool"}, target_names=names)
+    assert amap.mapping == {
+        2: RobotCommand.CLOSE_GRIPPER, 3: RobotCommand.CARRY_TOOL
+    }  # fmt: skip
+    assert amap.decide(_event(2, 50)).command is RobotCommand.CLOSE_GRIPPER
+    # Without target_names a name is matched against the event's name.
+    by_event = ActionMap({"wave": "move_to_tool"})
+    named = GestureEvent(label=1, start=0, end=9, confidence=0.9, emitted_at=20,
+                         name="wave")  # fmt: skip
+    assert by_event.decide(named).command is RobotCommand.MOVE_TO_TOOL
+    unnamed = by_event.decide(_event(1, 30))
+    assert not unnamed.issued and unnamed.reason == "class 1 has no command"
+    with pytest.raises(ValueError, match="unknown gesture class name 'jump'"):
+        ActionMap({"jump": "move_to_tool"}, target_names=names)
+    with pytest.raises(ValueError, match="beyond target_names"):
+        ActionMap({4: "move_to_tool"}, target_names=names)
+    with pytest.raises(ValueError, match="mapped twice"):
+        ActionMap({"wave": "move_to_tool", 1: "beep"}, target_names=names)
+    with pytest.raises(ValueError, match="0 is rest"):
+        ActionMap({0: "move_to_tool"})
+    with pytest.raises(TypeError, match="label .*or a class name"):
+        ActionMap({1.5: "move_to_tool"})
+    with pytest.raises(TypeError, match="mapping must be a dict"):
+        ActionMap([(1, "move_to_tool")])
+    with pytest.raises(TypeError, match="GestureEvent"):
+        ActionMap({1: "beep"}).decide("wave")
+
+
+def test_commander_refuses_the_wrong_objects():
+    amap, robot = ActionMap({1: "move_to_tool"}), SimulatedRobot()
+    rec = _ScriptedRecognizer([])
+    with pytest.raises(TypeError, match="recognizer must be a StreamingRecognizer"):
+        GestureCommander("recognizer", amap, robot)
+    with pytest.raises(TypeError, match="action_map must be an ActionMap"):
+        GestureCommander(rec, {1: "move_to_tool"}, robot)
+    with pytest.raises(TypeError, match="robot must be a PickAndPlaceRobot"):
+        GestureCommander(rec, amap, "robot")
+    with pytest.raises(TypeError, match="robot must be"):
+        GestureCommander(rec, amap, robot=None)

@@ -12,7 +12,9 @@ the place where a real robot plugs in (:meth:`PickAndPlaceRobot._perform`);
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import math
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
 from numbers import Integral, Real
@@ -30,7 +32,16 @@ __all__ = [
 
 
 class RobotCommand(str, Enum):
-    """The five actions of the paper's pick-and-place task, in task order."""
+    """The five actions of the paper's pick-and-place task, in task order.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import RobotCommand
+    >>> [str(c) for c in RobotCommand][:2]
+    ['move_to_tool', 'close_gripper']
+    >>> RobotCommand("carry_tool") is RobotCommand.CARRY_TOOL
+    True
+    """
 
     MOVE_TO_TOOL = "move_to_tool"
     CLOSE_GRIPPER = "close_gripper"
@@ -43,7 +54,14 @@ class RobotCommand(str, Enum):
 
 
 class RobotState(str, Enum):
-    """States of the pick-and-place cycle."""
+    """States of the pick-and-place cycle.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import RobotState, SimulatedRobot
+    >>> SimulatedRobot().state is RobotState.HOME
+    True
+    """
 
     HOME = "home"  # gripper open, empty, at the home pose
     AT_TOOL = "at_tool"  # gripper open around the tool
@@ -108,6 +126,13 @@ class CommandResult:
         ``"ok"`` or why it was refused.
     frame : int or None, default=None
         Stream frame at which it was issued.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import SimulatedRobot
+    >>> result = SimulatedRobot().execute("close_gripper", frame=40)
+    >>> result.accepted, result.reason, result.frame
+    (False, 'the gripper is not at the tool', 40)
     """
 
     command: RobotCommand
@@ -138,6 +163,17 @@ class PickAndPlaceRobot(ABC):
         Current state.
     log : list of CommandResult
         Every command received, accepted or not.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import PickAndPlaceRobot
+    >>> class PrintingRobot(PickAndPlaceRobot):
+    ...     def _perform(self, command):
+    ...         print("robot:", command)
+    >>> robot = PrintingRobot()
+    >>> robot.execute("move_to_tool").state_after.value
+    robot: move_to_tool
+    'at_tool'
     """
 
     def __init__(self):
@@ -253,6 +289,14 @@ class ActionDecision:
         The command issued, None when the event was ignored.
     reason : str
         ``"issued"`` or why the event was ignored.
+
+    Examples
+    --------
+    >>> from skgesture.streaming import ActionMap, GestureEvent
+    >>> ev = GestureEvent(label=2, start=0, end=30, confidence=0.9, emitted_at=42)
+    >>> decision = ActionMap({1: "move_to_tool"}).decide(ev)
+    >>> decision.issued, decision.reason
+    (False, 'class 2 has no command')
     """
 
     event: object
@@ -268,22 +312,36 @@ class ActionDecision:
 class ActionMap:
     """Maps gesture classes to commands, once per gesture.
 
-    An event is turned into its class's command when its confidence reaches
-    ``min_confidence`` and no command was issued in the last
-    ``refractory_frames`` frames (counted between the frames at which the
-    events were emitted), so that one gesture, even if it is recognised as two
-    overlapping events, gives one command.
+    An event is turned into its class's command when its confidence is a
+    number that reaches ``min_confidence`` (a NaN or infinite confidence never
+    does) and no command was issued in the last ``refractory_frames`` frames
+    (counted between the frames at which the events were emitted), so that
+    one gesture, even if it is recognised as two overlapping events, gives
+    one command.
 
     Parameters
     ----------
     mapping : dict
-        ``{gesture class: command}``; commands are :class:`RobotCommand`
-        values (strings such as ``"close_gripper"`` are converted) or any
-        object for other programs.
+        ``{gesture class: command}``. A class is its label (an int >= 1, as in
+        ``y``) or its name (a str): names are turned into labels with
+        ``target_names`` when given, else matched against the ``name`` of each
+        event (set when the recogniser has ``target_names``). Commands are
+        :class:`RobotCommand` values (strings such as ``"close_gripper"`` are
+        converted) or any object for other programs.
     min_confidence : float, default=0.0
-        Confidence floor.
+        Confidence floor, in [0, 1].
     refractory_frames : int, default=0
         Frames after an issued command during which events are ignored.
+    target_names : sequence of str or None, default=None
+        ``target_names[k - 1]`` names class ``k`` (as the dataset loaders'
+        ``target_names``), to write ``mapping`` with class names.
+
+    Attributes
+    ----------
+    mapping : dict
+        ``{label: command}`` for the classes given as labels or named through
+        ``target_names``, ``{name: command}`` for names matched at decision
+        time.
 
     Examples
     --------
@@ -296,22 +354,85 @@ class ActionMap:
     >>> late = GestureEvent(label=2, start=30, end=50, confidence=0.95, emitted_at=62)
     >>> amap.decide(late).reason
     'refractory: 10 frames after the last command (< 20)'
+    >>> names = ["wave", "point"]
+    >>> by_name = ActionMap({"point": "carry_tool"}, target_names=names)
+    >>> by_name.mapping
+    {2: <RobotCommand.CARRY_TOOL: 'carry_tool'>}
     """
 
-    def __init__(self, mapping, *, min_confidence=0.0, refractory_frames=0):
-        if not isinstance(min_confidence, Real) or not 0 <= min_confidence <= 1:
+    def __init__(
+        self, mapping, *, min_confidence=0.0, refractory_frames=0, target_names=None
+    ):
+        if (
+            isinstance(min_confidence, bool)
+            or not isinstance(min_confidence, Real)
+            or not 0 <= min_confidence <= 1
+        ):
             raise ValueError(
-                f"min_confidence must be in [0, 1], got {min_confidence!r}"
+                f"min_confidence must be a number in [0, 1], got {min_confidence!r}"
             )
-        if not isinstance(refractory_frames, Integral) or refractory_frames < 0:
+        if (
+            isinstance(refractory_frames, bool)
+            or not isinstance(refractory_frames, Integral)
+            or refractory_frames < 0
+        ):
             raise ValueError(
                 "refractory_frames must be a non-negative int, got "
                 f"{refractory_frames!r}"
             )
-        self.mapping = {int(k): _as_command(v) for k, v in dict(mapping).items()}
+        if not isinstance(mapping, Mapping):
+            raise TypeError(
+                "mapping must be a dict {gesture class: command}, got "
+                f"{type(mapping).__name__}"
+            )
+        if target_names is not None and (
+            isinstance(target_names, str)
+            or not all(isinstance(n, str) for n in target_names)
+        ):
+            raise TypeError(
+                f"target_names must be a sequence of class names, got {target_names!r}"
+            )
+        self.target_names = None if target_names is None else list(target_names)
+        self.mapping = {}
+        for key, command in mapping.items():
+            cls = self._class_key(key)
+            if cls in self.mapping:
+                raise ValueError(
+                    f"gesture class {key!r} is mapped twice (as {cls!r}); give one "
+                    f"command per class"
+                )
+            self.mapping[cls] = _as_command(command)
         self.min_confidence = min_confidence
         self.refractory_frames = refractory_frames
         self.reset()
+
+    def _class_key(self, key):
+        """A key of ``mapping`` as a label (int >= 1) or a name to match."""
+        if isinstance(key, str):
+            if self.target_names is None:
+                return key  # matched against event.name
+            if key not in self.target_names:
+                raise ValueError(
+                    f"unknown gesture class name {key!r}; target_names has "
+                    f"{self.target_names}"
+                )
+            return self.target_names.index(key) + 1
+        if isinstance(key, bool) or not isinstance(key, Integral):
+            raise TypeError(
+                f"a gesture class must be a label (int >= 1) or a class name (str), "
+                f"got {key!r} of type {type(key).__name__}"
+            )
+        if key < 1:
+            raise ValueError(
+                f"gesture class {key!r} cannot command anything: labels start at 1 "
+                f"(0 is rest)"
+            )
+        if self.target_names is not None and key > len(self.target_names):
+            raise ValueError(
+                f"gesture class {key} is beyond target_names "
+                f"({len(self.target_names)} classes)"
+            )
+        return int(key)
 
     def reset(self):
         """Forget the last issued command."""
@@ -330,13 +451,32 @@ class ActionMap:
         ActionDecision
             With ``command`` None when the event is ignored.
         """
+        for attr in ("label", "confidence", "emitted_at"):
+            if not hasattr(event, attr):
+                raise TypeError(
+                    f"ActionMap.decide takes a GestureEvent (label, confidence, "
+                    f"emitted_at), got {type(event).__name__}"
+                )
         command = self.mapping.get(int(event.label))
+        name = getattr(event, "name", None)
+        if command is None and name is not None:
+            command = self.mapping.get(name)
         if command is None:
-            return ActionDecision(event, None, f"class {event.label} has no command")
-        if event.confidence < self.min_confidence:
+            what = f"class {event.label}" + (f" ({name})" if name else "")
+            return ActionDecision(event, None, f"{what} has no command")
+        confidence = event.confidence
+        try:
+            number = isinstance(confidence, Real) and math.isfinite(confidence)
+        except TypeError:
+            number = False
+        if not number:
+            return ActionDecision(
+                event, None, f"confidence {confidence!r} is not a finite number"
+            )
+        if not confidence >= self.min_confidence:
             return ActionDecision(
                 event, None,
-                f"confidence {event.confidence:.2f} < {self.min_confidence:g}",
+                f"confidence {confidence:.2f} < {self.min_confidence:g}",
             )  # fmt: skip
         if self._last_issued is not None:
             gap = event.emitted_at - self._last_issued
@@ -377,9 +517,40 @@ class GestureCommander:
         ``(decision, result)`` for every event: the :class:`ActionDecision`
         and the robot's :class:`CommandResult` (None when no command was
         issued).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn.linear_model import LogisticRegression
+    >>> from skgesture import make_method_a
+    >>> from skgesture.datasets import make_gesture_streams
+    >>> from skgesture.streaming import (ActionMap, GestureCommander,
+    ...                                  SimulatedRobot, StreamingRecognizer)
+    >>> data = make_gesture_streams(n_sequences=4, n_classes=3, random_state=0)
+    >>> pipe = make_method_a(random_state=0).set_params(
+    ...     segmenter__estimator=LogisticRegression(),
+    ...     classifier__estimator=LogisticRegression()).fit(data.X[:3], data.y[:3])
+    >>> commander = GestureCommander(
+    ...     StreamingRecognizer(pipe), ActionMap({1: "move_to_tool"}),
+    ...     SimulatedRobot())
+    >>> log = commander.run(data.X[3])
+    >>> all(result is None or result.command == "move_to_tool"
+    ...     for _, result in log)
+    True
     """
 
     def __init__(self, recognizer, action_map, robot):
+        for arg, value, methods, kind in (
+            ("recognizer", recognizer, ("push", "flush"), "a StreamingRecognizer"),
+            ("action_map", action_map, ("decide",), "an ActionMap"),
+            ("robot", robot, ("execute",), "a PickAndPlaceRobot"),
+        ):
+            if not all(callable(getattr(value, m, None)) for m in methods):
+                raise TypeError(
+                    f"GestureCommander: {arg} must be {kind} (with "
+                    f"{', '.join(m + '()' for m in methods)}), got "
+                    f"{type(value).__name__}"
+                )
         self.recognizer = recognizer
         self.action_map = action_map
         self.robot = robot

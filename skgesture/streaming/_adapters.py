@@ -20,6 +20,7 @@ skgesture stage treats as untracked. A :class:`SkeletonSource` yields frames
 
 import time
 from abc import ABC, abstractmethod
+from numbers import Real
 
 import numpy as np
 
@@ -127,6 +128,27 @@ TORSO_HEIGHT_RATIO = 0.288
 DEFAULT_BODY_HEIGHT = 1.70  # metres
 
 
+def _as_positions(X, what, n_joints=None):
+    """``X`` as a float64 array, or a clear error for anything that is not one."""
+    expect = (
+        f"an array of joint positions of shape ({n_joints}, 3) or (n_frames, "
+        f"{n_joints}, 3)"
+        if n_joints is not None
+        else "an array of joint positions of shape (n_frames, n_joints, 3)"
+    )
+    if isinstance(X, (str, bytes, dict)) or X is None:
+        raise TypeError(f"{what} must be {expect}, got {type(X).__name__}")
+    try:
+        arr = np.asarray(X)
+        if arr.dtype.kind == "c":
+            raise ValueError("got complex values")
+        if arr.dtype.kind not in "biuf":
+            arr = np.asarray(X, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be {expect} of real numbers: {exc}") from None
+    return arr.astype(np.float64, copy=False)
+
+
 def _sources_matrix(sources, names):
     """``(20, J)`` averaging matrix: Kinect v1 joint = mean of its sources."""
     M = np.zeros((KINECT_V1.n_joints, len(names)))
@@ -149,6 +171,18 @@ class SkeletonAdapter(ABC):
         Joints per input frame.
     name : str
         Short name of the source layout.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.streaming import SkeletonAdapter
+    >>> class Mirror(SkeletonAdapter):  # a Kinect v1 sensor seen in a mirror
+    ...     name = "kinect_v1_mirrored"
+    ...     def _convert(self, X):
+    ...         return X * np.array([-1.0, 1.0, 1.0])
+    >>> frame = np.full((20, 3), 0.5)
+    >>> Mirror()(frame)[0].tolist()
+    [-0.5, 0.5, 0.5]
     """
 
     n_joints = KINECT_V1.n_joints
@@ -168,7 +202,7 @@ class SkeletonAdapter(ABC):
         ndarray of shape (20, 3) or (n_frames, 20, 3)
             Kinect v1 positions in metres, float64; untracked frames are zeros.
         """
-        X = np.asarray(X, dtype=np.float64)
+        X = _as_positions(X, f"{type(self).__name__} input", self.n_joints)
         single = X.ndim == 2
         if single:
             X = X[None]
@@ -198,8 +232,8 @@ class KinectV1Adapter(SkeletonAdapter):
     >>> import numpy as np
     >>> from skgesture.streaming import KinectV1Adapter
     >>> frame = np.ones((20, 3)); frame[0, 0] = np.nan
-    >>> KinectV1Adapter()(frame).sum()
-    np.float64(0.0)
+    >>> float(KinectV1Adapter()(frame).sum())
+    0.0
     """
 
     def _convert(self, X):
@@ -440,12 +474,11 @@ def get_adapter(name, **params):
     >>> get_adapter("azure_kinect").n_joints
     32
     """
-    try:
-        cls = _ADAPTERS[name]
-    except KeyError:
+    cls = _ADAPTERS.get(name) if isinstance(name, str) else None
+    if cls is None:
         raise ValueError(
             f"unknown layout {name!r}; known: {', '.join(sorted(_ADAPTERS))}"
-        ) from None
+        )
     return cls(**params)
 
 
@@ -527,14 +560,19 @@ class ReplaySource(SkeletonSource):
     ):
         if isinstance(adapter, str):
             adapter = get_adapter(adapter)
+        if adapter is not None and not isinstance(adapter, SkeletonAdapter):
+            raise TypeError(
+                "adapter must be a SkeletonAdapter, a layout name (see get_adapter) "
+                f"or None, got {type(adapter).__name__}"
+            )
         self.adapter = adapter or KinectV1Adapter()
-        self.X = np.asarray(X, dtype=np.float64)
+        self.X = _as_positions(X, "ReplaySource X")
         if self.X.ndim != 3:
             raise ValueError(
                 f"X must have shape (n_frames, n_joints, 3), got {self.X.shape}"
             )
-        if not fps > 0:
-            raise ValueError(f"fps must be positive, got {fps!r}")
+        if isinstance(fps, bool) or not isinstance(fps, Real) or not 0 < fps < np.inf:
+            raise ValueError(f"fps must be a positive finite number, got {fps!r}")
         self.fps = float(fps)
         self.realtime = realtime
         self.clock = clock
