@@ -21,12 +21,19 @@ _LAZY = {
     "MultiScaleClassifier": "skgesture._multiscale",
     "BiLSTMTagger": "skgesture._bilstm",
     "TorchMLPClassifier": "skgesture._mlp",
+    "JointFeatures": "skgesture._features",
+    "SkeletonAugmenter": "skgesture._augment",
+    "SequenceTagger": "skgesture._tagger",
+    "VotingTagger": "skgesture._tagger",
+    "make_recommended": "skgesture._pipelines",
     "make_method_a": "skgesture._pipelines",
     "make_method_b": "skgesture._pipelines",
     "make_method_c": "skgesture._pipelines",
     "StreamingRecognizer": "skgesture.streaming",
     "labels_to_segments": "skgesture.utils._segments",
     "segments_to_labels": "skgesture.utils._segments",
+    "save_model": "skgesture._persistence",
+    "load_model": "skgesture._persistence",
 }
 
 _SUBMODULES = {"datasets", "metrics", "utils", "layouts", "streaming", "plotting"}

@@ -4,15 +4,18 @@
 
 from sklearn.pipeline import Pipeline
 
+from skgesture._augment import SkeletonAugmenter
 from skgesture._bilstm import BiLSTMTagger
 from skgesture._descriptor import PoseDescriptor
+from skgesture._features import JointFeatures
 from skgesture._multiscale import MultiScaleClassifier, default_window_network
 from skgesture._segmenter import ActivitySegmenter, default_frame_network
+from skgesture._tagger import SequenceTagger
 from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
 
-__all__ = ["make_method_a", "make_method_b", "make_method_c"]
+__all__ = ["make_method_a", "make_method_b", "make_method_c", "make_recommended"]
 
-# METHOD_SPEC §6.3
+# docs/method.md §6.3
 WEIGHTS_B = (0.4895, 0.4576, 0.0529)
 THRESHOLD_SHORT_B = 0.6014
 THRESHOLD_LONG_B = 0.6033
@@ -31,7 +34,9 @@ _DOC_COMMON = """
     random_state : int, RandomState instance or None, default=None
         Seeds every network.
     verbose : int, default=0
-        Verbosity of the networks.
+        0 is silent; 1 shows progress bars (the segmenter's network, the
+        classifier's scales and their networks); 2 prints one line per epoch
+        of every network.
 """
 
 
@@ -52,7 +57,7 @@ def _multiscale_pipeline(
             )
         )
     stages += [
-        ("windows", DynamicPoseWindow(steps=steps)),
+        ("windows", DynamicPoseWindow(steps=steps, lazy=True)),
         (
             "classifier",
             MultiScaleClassifier(
@@ -75,7 +80,7 @@ def make_method_a(
 
     PoseDescriptor -> ActivitySegmenter -> DynamicPoseWindow(steps=(4,)) ->
     MultiScaleClassifier with thresholds 0.8717 (short periods) and 0.6255
-    (long periods), METHOD_SPEC §5.
+    (long periods), docs/method.md §5.
     {common}
     Returns
     -------
@@ -105,7 +110,7 @@ def make_method_b(
     """Method B: three time scales (steps 4, 3, 2) with fused scores.
 
     As :func:`make_method_a` with ``steps=(4, 3, 2)``, fusion weights
-    (0.4895, 0.4576, 0.0529) and thresholds 0.6014 / 0.6033, METHOD_SPEC §6.
+    (0.4895, 0.4576, 0.0529) and thresholds 0.6014 / 0.6033, docs/method.md §6.
     {common}
     Returns
     -------
@@ -151,7 +156,7 @@ def make_method_c(
 
     PoseDescriptor -> BiLSTMTagger: every frame gets one of K + 1 classes,
     probabilities are loess-smoothed and gesture runs shorter than 15 frames
-    become rest (METHOD_SPEC §7).
+    become rest (docs/method.md §7).
 
     Parameters
     ----------
@@ -191,3 +196,91 @@ def make_method_c(
     }
     tagger = BiLSTMTagger.paper(**params) if paper else BiLSTMTagger(**params)
     return Pipeline([("descriptor", PoseDescriptor(joints=joints)), ("tagger", tagger)])
+
+
+def make_recommended(
+    *,
+    joints="paper11",
+    features="joints",
+    memory=None,
+    random_state=None,
+    verbose=0,
+    device="cpu",
+):
+    """The model we recommend: normalised joints and a temporal convolutional tagger.
+
+    ``JointFeatures -> SequenceTagger(architecture="tcn")``: joint positions
+    relative to the hip in trunk lengths, with their velocities, read by a
+    three-stage dilated temporal convolutional network (32 channels, 8 layers a
+    stage, a smoothing loss; Farha & Gall's MS-TCN) that sees whole sequences,
+    trained with AdamW and a warm-up cosine schedule on augmented 256-frame
+    crops (rotation about the vertical axis, scale, time warp, noise). On
+    PRECOG, leave one subject out, it is the best model of the benchmark; see
+    docs/choosing.md for when it wins over the paper's methods and
+    docs/benchmarks.md for the numbers beside the peers.
+
+    Parameters
+    ----------
+    joints : {"paper11", "full20"} or sequence of str, default="paper11"
+        Joints of the features: the paper's 11 upper-body joints or all 20
+        (better whenever the legs move, e.g. kicks).
+    features : {"joints", "descriptor"}, default="joints"
+        ``"joints"``: :class:`JointFeatures` (the better choice on recorded
+        people). ``"descriptor"``: the paper's :class:`PoseDescriptor`, with
+        time warp and noise as the only augmentations; it wins when the
+        recordings differ in ways the descriptor is invariant to (the synthetic
+        streams of :func:`~skgesture.datasets.make_gesture_streams`).
+    memory : None, str or joblib.Memory, default=None
+        Cache of the trained network, so that the decoding parameters
+        (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``) can
+        be searched without retraining.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the network, the crops and the augmentation.
+    verbose : int, default=0
+        0 silent, 1 a progress bar over epochs, 2 one line per epoch.
+    device : str, default="cpu"
+        Torch device of the training.
+
+    Returns
+    -------
+    sklearn.pipeline.Pipeline
+        The unfitted pipeline; ``predict`` gives per-frame labels.
+
+    Examples
+    --------
+    >>> from skgesture import make_recommended
+    >>> model = make_recommended(joints="full20")
+    >>> [name for name, _ in model.steps], model.named_steps["tagger"].architecture
+    (['features', 'tagger'], 'tcn')
+    """
+    if features not in ("joints", "descriptor"):
+        raise ValueError(f"features must be 'joints' or 'descriptor', got {features!r}")
+    if features == "joints":
+        step = JointFeatures(joints=joints)
+        augment = SkeletonAugmenter(
+            rotation=20.0, scale=0.15, time_warp=0.2, noise=0.02
+        )
+    else:
+        # The descriptor is built from angles and distances: rotating or
+        # scaling its 183/426 values as coordinates would be meaningless.
+        step = PoseDescriptor(joints=joints)
+        augment = SkeletonAugmenter(rotation=0.0, scale=0.0, time_warp=0.2, noise=0.02)
+    tagger = SequenceTagger(
+        architecture="tcn",
+        hidden_sizes=(32,),
+        tcn_layers=8,
+        tcn_stages=3,
+        dropout=0.3,
+        smoothing_weight=0.15,
+        crop_length=256,
+        batch_size=16,
+        steps_per_epoch=20,
+        max_epochs=30,
+        learning_rate=3e-3,
+        augment=augment,
+        memory=memory,
+        device=device,
+        random_state=random_state,
+        verbose=verbose,
+    )
+    return Pipeline([("features", step), ("tagger", tagger)])

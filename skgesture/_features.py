@@ -1,0 +1,481 @@
+"""JointFeatures: body-normalised joint positions and velocities per frame.
+
+The input a practitioner gives a sequence network: every joint relative to the
+hip, in units of the subject's own trunk length, plus its velocity. Unlike the
+paper's :class:`~skgesture.PoseDescriptor` the features stay 3-D vectors
+(xyz triples), so that augmentations such as a rotation about the vertical axis
+apply to them directly (:class:`~skgesture.SkeletonAugmenter`).
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from numbers import Integral
+
+import numpy as np
+from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
+from sklearn.utils._param_validation import Interval, StrOptions
+from sklearn.utils.validation import check_is_fitted
+
+from skgesture._descriptor import _fill_missing
+from skgesture.layouts import KINECT_V1, N_COORDS, get_descriptor_joints
+from skgesture.utils._validation import (
+    check_skeletons,
+    missing_frames,
+    refuse_set_output,
+)
+
+__all__ = ["JointFeatures"]
+
+ROOT = "HipCenter"
+TRUNK_TOP = "ShoulderCenter"
+MIN_TRUNK = 1e-6  # a trunk shorter than this (degenerate skeleton) scales by 1
+
+
+def _joint_names(joints):
+    """Joint names of a ``joints`` specification, in Kinect v1 storage order."""
+    if isinstance(joints, str):
+        names = get_descriptor_joints(joints).joints
+    else:
+        names = tuple(joints)
+    idx = KINECT_V1.indices(names)  # raises naming an unknown joint
+    if len(set(idx)) != len(idx):
+        raise ValueError(f"joints has duplicates: {list(names)}")
+    if ROOT not in names:
+        raise ValueError(
+            f"joints must contain the root {ROOT!r} (its row carries the hip "
+            f"motion), got {list(names)}"
+        )
+    order = np.argsort(idx)
+    return tuple(names[k] for k in order), np.asarray(idx)[order]
+
+
+def _yaw_rotation(across):
+    """Rotation about the vertical (y) axis putting the median hips along +x.
+
+    ``across`` is the median left-to-right hip vector (HipRight - HipLeft).
+    """
+    norm = np.hypot(across[0], across[2])
+    if norm < MIN_TRUNK:
+        return np.eye(N_COORDS)
+    c, s = across[0] / norm, across[2] / norm
+    # Maps (c, ., s) to (1, ., 0).
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def joint_features(
+    seq,
+    joint_index,
+    *,
+    velocities=True,
+    accelerations=False,
+    align=False,
+    fill="linear",
+):
+    """Normalised positions (and derivatives) of one raw sequence.
+
+    Parameters
+    ----------
+    seq : ndarray of shape (n_frames, 20, 3)
+        Raw skeleton sequence (Kinect v1 order); untracked frames are all zero
+        or NaN.
+    joint_index : ndarray of int
+        Kinect v1 indices of the joints kept, the root among them.
+    velocities, accelerations : bool
+        Append first / second time differences (``numpy.gradient``).
+    align : bool
+        Rotate every sequence about the vertical axis so that its median
+        left-to-right hip direction is the x axis.
+    fill : {"linear", "hold"}
+        How untracked frames are filled before differentiating.
+
+    Returns
+    -------
+    ndarray of shape (n_frames, n_features)
+        xyz triples: the joints (the root replaced by its offset from the
+        sequence's median root position), then their derivatives; float32.
+    """
+    seq = np.asarray(seq, dtype=np.float64)
+    n = len(seq)
+    missing = missing_frames(seq)
+    width = len(joint_index) * N_COORDS * (1 + velocities + accelerations)
+    if missing.all():
+        return np.zeros((n, width), dtype=np.float32)
+    q = _fill_missing(np.nan_to_num(seq), missing, fill)
+    stats = _statistics(_frame_quantities(q[~missing]), align)
+    flat = _normalised(q, joint_index, stats)
+    return _with_derivatives(flat, velocities, accelerations)
+
+
+# The steps of joint_features, shared with the stream step of JointFeatures
+# (skgesture/_incremental.py, JointFeatureStream), which applies them to the
+# frames a row needs with the statistics of a trailing window.
+
+
+def _frame_quantities(q):
+    """Per-frame quantities behind the statistics: ``(n, 7)`` rows of the
+    trunk length, the hip position and the left-to-right hip vector."""
+    root, top = KINECT_V1.index(ROOT), KINECT_V1.index(TRUNK_TOP)
+    left, right = KINECT_V1.index("HipLeft"), KINECT_V1.index("HipRight")
+    out = np.empty((len(q), 7))
+    out[:, 0] = np.linalg.norm(q[:, top] - q[:, root], axis=1)
+    out[:, 1:4] = q[:, root]
+    out[:, 4:7] = q[:, right] - q[:, left]
+    return out
+
+
+def _statistics(quantities, align, median=None):
+    """``(scale, hip, rotation)`` from the quantities of the tracked frames: the
+    median trunk length (1 if degenerate), the median hip position and, with
+    ``align``, the yaw rotation of the median hip direction (else None).
+    ``median``: the column medians, if known (a stream keeps them sorted)."""
+    if median is None:
+        median = np.median(quantities if align else quantities[:, :4], axis=0)
+    scale = median[0] if median[0] > MIN_TRUNK else 1.0
+    rotation = _yaw_rotation(median[4:7]) if align else None
+    return scale, median[1:4], rotation
+
+
+def _normalised(q, joint_index, stats):
+    """Joints relative to the hip in trunk lengths (the root row: the hip's
+    offset from the median hip), flattened to ``(n, 3 * n_joints)``."""
+    scale, hip_median, rotation = stats
+    root = KINECT_V1.index(ROOT)
+    hip = q[:, root].copy()
+    rel = q - hip[:, None, :]
+    rel[:, root] = hip - hip_median
+    if rotation is not None:
+        rel = rel @ rotation.T
+    return (rel[:, joint_index] / scale).reshape(len(q), -1)
+
+
+def _with_derivatives(flat, velocities, accelerations):
+    """``flat`` with its ``numpy.gradient`` velocities and accelerations, float32."""
+    n = len(flat)
+    parts = [flat]
+    if velocities or accelerations:
+        vel = np.gradient(flat, axis=0) if n > 1 else np.zeros_like(flat)
+        if velocities:
+            parts.append(vel)
+        if accelerations:
+            parts.append(np.gradient(vel, axis=0) if n > 1 else np.zeros_like(flat))
+    return np.hstack(parts).astype(np.float32)
+
+
+class JointFeatures(TransformerMixin, BaseEstimator):
+    """Body-normalised joint positions and velocities of every frame.
+
+    Per sequence: untracked frames are filled (as :class:`PoseDescriptor`
+    does), every joint is taken relative to HipCenter and divided by the
+    sequence's median HipCenter-ShoulderCenter length, the HipCenter row is
+    replaced by the hip's offset from its median position (so whole-body
+    motion such as a step is kept), and the per-frame velocities
+    (``numpy.gradient`` along time) are appended. The result is a block of
+    xyz triples: 66 features for the paper's 11 joints, 120 for all 20.
+
+    These are the inputs of the recommended model
+    (:func:`~skgesture.make_recommended`). The transformer has no learned
+    statistics: standardisation happens in the tagger, after augmentation.
+
+    Parameters
+    ----------
+    joints : {"paper11", "full20"} or sequence of str, default="paper11"
+        Joints kept: the paper's 11 upper-body joints, all 20 Kinect v1
+        joints, or a list of Kinect v1 joint names (HipCenter included).
+    velocities : bool, default=True
+        Append the velocity of every feature.
+    accelerations : bool, default=False
+        Append the acceleration of every feature.
+    align : bool, default=False
+        Rotate each sequence about the vertical axis so that the subject's
+        median left-to-right hip direction is the x axis (removes the camera
+        yaw, at the price of the orientation's estimation noise).
+    fill : {"linear", "hold"}, default="linear"
+        Filling of untracked frames before differentiation.
+    stream_stats_window : int, default=600
+        Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
+        the statistics (median trunk length, hip position, hip direction) are
+        those of the last ``stream_stats_window`` tracked frames received
+        when a row is emitted (600: 30 s at 20 fps); offline they are the
+        whole sequence's (docs/streaming.md, "The recommended model").
+    stream_warmup : int, default=0
+        Streaming only: the first rows wait until this many frames have
+        arrived, so that their statistics rest on more frames (0: no wait; a
+        longer wait changed nothing measurable, docs/streaming.md).
+
+    Attributes
+    ----------
+    joint_names_ : tuple of str
+        Joints kept, in Kinect v1 storage order (the feature order).
+    n_features_out_ : int
+        Number of features per frame.
+    frame_shape_in_ : tuple of int
+        Shape of one input frame seen in ``fit``, ``(20, 3)``.
+    n_features_in_ : int
+        Number of values per input frame (60).
+
+    See Also
+    --------
+    PoseDescriptor : The paper's 183-D descriptor.
+    SequenceTagger : The network these features feed in the recommended model.
+
+    Notes
+    -----
+    Untracked frames are rest by construction (docs/design.md): a sequence
+    with untracked frames is returned as a ``numpy.ma.MaskedArray`` whose
+    masked rows are those frames. Input rules (finite values, magnitude at
+    most 1e5) are those of :class:`PoseDescriptor`.
+
+    Examples
+    --------
+    >>> from skgesture import JointFeatures
+    >>> from skgesture.utils._testing import make_skeleton_stream
+    >>> X, y = make_skeleton_stream(random_state=0)
+    >>> F = JointFeatures().fit_transform([X])
+    >>> F[0].shape == (len(X), 66)
+    True
+    >>> JointFeatures(joints="full20").fit([X]).n_features_out_
+    120
+    """
+
+    _parameter_constraints: dict = {
+        "joints": [StrOptions({"paper11", "full20"}), list, tuple],
+        "velocities": ["boolean"],
+        "accelerations": ["boolean"],
+        "align": ["boolean"],
+        "fill": [StrOptions({"linear", "hold"})],
+        "stream_stats_window": [Interval(Integral, 1, None, closed="left")],
+        "stream_warmup": [Interval(Integral, 0, None, closed="left")],
+    }
+
+    def __init__(
+        self,
+        *,
+        joints="paper11",
+        velocities=True,
+        accelerations=False,
+        align=False,
+        fill="linear",
+        stream_stats_window=600,
+        stream_warmup=0,
+    ):
+        self.joints = joints
+        self.velocities = velocities
+        self.accelerations = accelerations
+        self.align = align
+        self.fill = fill
+        self.stream_stats_window = stream_stats_window
+        self.stream_warmup = stream_warmup
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y=None):
+        """Check the input and record the joint set.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, 20, 3)
+            Skeleton sequences (Kinect v1 joint order).
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        self : JointFeatures
+            The fitted transformer.
+        """
+        check_skeletons(X, estimator=self, reset=True)
+        self.joint_names_, self._joint_index = _joint_names(self.joints)
+        n_parts = 1 + self.velocities + self.accelerations
+        self.n_features_out_ = len(self.joint_names_) * N_COORDS * n_parts
+        return self
+
+    def transform(self, X):
+        """Compute the features of every frame.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, 20, 3)
+            Skeleton sequences.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i, n_features_out_)
+            The float32 features; a sequence with untracked frames comes as a
+            ``numpy.ma.MaskedArray`` whose masked rows are those frames.
+        """
+        check_is_fitted(self)
+        names, index = _joint_names(self.joints)
+        if names != self.joint_names_:
+            raise ValueError(
+                f"joints was changed after fit ({list(self.joint_names_)} -> "
+                f"{list(names)}); refit the features and every stage after them"
+            )
+        X = check_skeletons(X, estimator=self, reset=False)
+        out = []
+        for seq in X:
+            feats = joint_features(
+                seq,
+                index,
+                velocities=self.velocities,
+                accelerations=self.accelerations,
+                align=self.align,
+                fill=self.fill,
+            )
+            rows = missing_frames(seq)
+            if rows.any():
+                feats = np.ma.MaskedArray(
+                    feats, mask=np.repeat(rows[:, None], feats.shape[1], axis=1)
+                )
+            out.append(feats)
+        return out
+
+    def set_output(self, *, transform=None):
+        """Refuse a DataFrame output: a list of sequences has none.
+
+        Parameters
+        ----------
+        transform : {"default"} or None, default=None
+            Only ``"default"`` and ``None`` (no change) are accepted.
+
+        Returns
+        -------
+        self : JointFeatures
+            Unchanged.
+        """
+        return refuse_set_output(self, transform)
+
+    def get_feature_names_out(self, input_features=None):
+        """Get the names of the features, e.g. ``"pos_HandRight_x"``, ``"vel_Head_y"``.
+
+        Parameters
+        ----------
+        input_features : None
+            Ignored; present for API consistency.
+
+        Returns
+        -------
+        ndarray of str of shape (n_features_out_,)
+            Feature names in output order.
+        """
+        check_is_fitted(self)
+        kinds = ["pos"] + ["vel"] * self.velocities + ["acc"] * self.accelerations
+        names = [
+            f"{kind}_{joint}_{c}"
+            for kind in kinds
+            for joint in self.joint_names_
+            for c in "xyz"
+        ]
+        return np.asarray(names, dtype=object)
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        tags.input_tags.allow_nan = True
+        tags.requires_fit = True
+        return tags
+
+    # -- incremental step (docs/design.md §4.1, "Incremental steps") -----------
+    # The state and the per-row arithmetic live in skgesture/_incremental.py
+    # (JointFeatureStream), built on the steps of joint_features above.
+
+    def stream_init(self, *, max_backfill=64, **options):
+        """A fresh state for one live stream (docs/design.md §4.1).
+
+        Parameters
+        ----------
+        max_backfill : int, default=64
+            Untracked frames at the start of a stream that wait for the first
+            tracked frame and become copies of it, as offline filling does;
+            earlier ones are handed on at once as rest (masked zero rows).
+        **options
+            Options of other stages, ignored.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+
+        Examples
+        --------
+        >>> from skgesture import JointFeatures
+        >>> from skgesture._incremental import stream_frames
+        >>> from skgesture.utils._testing import make_skeleton_stream
+        >>> X, _ = make_skeleton_stream(random_state=0)
+        >>> feats = JointFeatures(stream_warmup=0).fit([X])
+        >>> state = feats.stream_init()
+        >>> rows, state = feats.stream_step(state, stream_frames(X[:10], 0))
+        >>> len(rows), feats.stream_lookahead  # rows 0..8 are final with frame 9
+        (9, 1)
+        >>> last, state = feats.stream_flush(state)
+        >>> len(last), rows.data.shape[1] == feats.n_features_out_
+        (1, True)
+        """
+        from skgesture._incremental import JointFeatureStream
+
+        check_is_fitted(self)
+        names, _ = _joint_names(self.joints)
+        if names != self.joint_names_:
+            raise ValueError(
+                f"joints was changed after fit ({list(self.joint_names_)} -> "
+                f"{list(names)}); refit the features and every stage after them"
+            )
+        return JointFeatureStream(self, max_backfill=max_backfill)
+
+    def stream_step(self, state, rows):
+        """Raw frames in; the feature rows that became final out.
+
+        Every frame is checked as :meth:`transform` checks it, and a bad one
+        raises a ``ValueError`` naming its index in the stream (the state is
+        then unchanged). Row ``t`` comes with frame ``t + 1`` (``t + 2`` with
+        accelerations; the central differences of ``numpy.gradient``), the
+        first rows not before frame ``stream_warmup - 1``, normalised with the
+        statistics of the last ``stream_stats_window`` tracked frames received
+        by then. Untracked frames hold the last tracked frame (the future is
+        unknown; offline ``fill="hold"``) and come out masked.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next raw frames ``(n, 20, 3)``, with their stream indices as
+            ``time``.
+
+        Returns
+        -------
+        out : Rows
+            Feature rows ``(m, n_features_out_)``, float32, masked where
+            untracked.
+        state : object
+            The updated state.
+        """
+        from skgesture._incremental import Rows, check_stream_frames
+
+        frames = check_stream_frames(self, rows.data, int(rows.time[0]))
+        return state.step(Rows(frames, rows.mask, rows.time)), state
+
+    def stream_flush(self, state):
+        """End of the stream: the last rows, with one-sided end differences.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : Rows
+            The remaining rows.
+        state : object
+            The spent state.
+        """
+        return state.flush(), state
+
+    @property
+    def stream_lookahead(self):
+        """Frames after a frame that its row needs (1; 2 with accelerations).
+
+        The central differences of ``numpy.gradient``; 0 without velocities
+        and accelerations.
+        """
+        return 2 if self.accelerations else int(bool(self.velocities))

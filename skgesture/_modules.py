@@ -1,0 +1,203 @@
+"""Torch modules of the sequence taggers: every one maps ``(batch, time, features)``
+to per-frame logits ``(batch, time, classes)``.
+
+* :class:`RecurrentTaggerModule`: stacked bidirectional GRUs or LSTMs with a
+  linear read-out per frame (the recommended tagger; Method C's BiLSTM is the
+  LSTM case with the paper's activation, dropout and initialisation).
+* :class:`TemporalConvModule`: MS-TCN (Farha & Gall, CVPR 2019): a stage of
+  dilated residual 1-D convolutions, then refinement stages that read the
+  previous stage's probabilities. Returns the logits of every stage (a tuple),
+  so the loss can supervise each; the last one is the prediction.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import numpy as np
+import torch
+from torch import nn
+from torch.nn import functional as F
+
+__all__ = [
+    "RecurrentTaggerModule",
+    "TemporalConvModule",
+    "final_logits",
+    "frame_probabilities",
+]
+
+LEAKY_SLOPE = 0.01  # docs/method.md §7.2: LeakyReLU between the paper's BiLSTMs
+KERNEL = 3  # MS-TCN's dilated convolution width
+
+
+def final_logits(output):
+    """The prediction of a module output: the last stage of a tuple, or itself."""
+    return output[-1] if isinstance(output, (tuple, list)) else output
+
+
+def frame_probabilities(module, batch):
+    """Per-frame softmax probabilities of ``module`` on a batch of sequences.
+
+    Parameters
+    ----------
+    module : torch.nn.Module
+        A tagger module in eval mode, mapping ``(batch, time, features)`` to
+        logits (or a tuple of stages, the last one read).
+    batch : ndarray of float32 of shape (n_sequences, n_frames, n_features)
+        Sequences of equal length.
+
+    Returns
+    -------
+    ndarray of float64 of shape (n_sequences, n_frames, n_classes)
+        Probabilities.
+    """
+    device = next(module.parameters()).device
+    with torch.inference_mode():
+        logits = final_logits(module(torch.as_tensor(batch, device=device)))
+        return torch.softmax(logits, dim=-1).cpu().numpy().astype(np.float64)
+
+
+class RecurrentTaggerModule(nn.Module):
+    """Stacked bidirectional recurrent layers and a linear read-out per frame.
+
+    Parameters
+    ----------
+    n_inputs : int
+        Features per frame.
+    n_outputs : int
+        Classes.
+    hidden_sizes : tuple of int, default=(64, 64)
+        Units per direction of each layer, input side first.
+    cell : {"gru", "lstm"}, default="gru"
+        Recurrent cell.
+    dropout : float, default=0.0
+        Drop probability between layers.
+    activation : {"none", "leaky_relu"}, default="none"
+        Non-linearity between layers (the paper's BiLSTM uses LeakyReLU).
+    init : {"torch", "matlab"}, default="torch"
+        Weight initialisation: torch's defaults, or MATLAB's (Glorot-uniform
+        input and read-out weights, orthogonal recurrent weights, LSTM
+        forget-gate bias 1; docs/method.md §7.2).
+    """
+
+    def __init__(
+        self,
+        n_inputs,
+        n_outputs,
+        hidden_sizes=(64, 64),
+        cell="gru",
+        dropout=0.0,
+        activation="none",
+        init="torch",
+    ):
+        super().__init__()
+        layer = {"gru": nn.GRU, "lstm": nn.LSTM}[cell]
+        self.cell = cell
+        self.layers = nn.ModuleList()
+        width = n_inputs
+        for size in hidden_sizes:
+            self.layers.append(layer(width, size, batch_first=True, bidirectional=True))
+            width = 2 * size
+        self.activation = (
+            nn.LeakyReLU(LEAKY_SLOPE) if activation == "leaky_relu" else nn.Identity()
+        )
+        self.dropout = nn.Dropout(dropout)
+        self.head = nn.Linear(width, n_outputs)
+        if init == "matlab":
+            self._matlab_init()
+
+    def _matlab_init(self):
+        for rnn in self.layers:
+            size = rnn.hidden_size
+            for name, param in rnn.named_parameters():
+                if name.startswith("weight_ih"):
+                    nn.init.xavier_uniform_(param)
+                elif name.startswith("weight_hh"):
+                    nn.init.orthogonal_(param)
+                elif name.startswith("bias_ih") and self.cell == "lstm":
+                    nn.init.zeros_(param)
+                    with torch.no_grad():
+                        param[size : 2 * size] = 1.0  # torch gate order i, f, g, o
+                else:  # the other biases (they add up)
+                    nn.init.zeros_(param)
+        nn.init.xavier_uniform_(self.head.weight)
+        nn.init.zeros_(self.head.bias)
+
+    def forward(self, X):
+        out = X
+        for k, rnn in enumerate(self.layers):
+            out, _ = rnn(out)
+            if k < len(self.layers) - 1:
+                out = self.dropout(self.activation(out))
+        return self.head(out)
+
+
+class _DilatedResidual(nn.Module):
+    def __init__(self, dilation, channels, dropout):
+        super().__init__()
+        self.conv = nn.Conv1d(
+            channels, channels, KERNEL, padding=dilation, dilation=dilation
+        )
+        self.mix = nn.Conv1d(channels, channels, 1)
+        self.dropout = nn.Dropout(dropout)
+
+    def forward(self, x):
+        return x + self.dropout(self.mix(F.relu(self.conv(x))))
+
+
+class _Stage(nn.Module):
+    def __init__(self, n_inputs, n_outputs, channels, n_layers, dropout):
+        super().__init__()
+        self.inp = nn.Conv1d(n_inputs, channels, 1)
+        self.layers = nn.ModuleList(
+            _DilatedResidual(2**k, channels, dropout) for k in range(n_layers)
+        )
+        self.out = nn.Conv1d(channels, n_outputs, 1)
+
+    def forward(self, x):
+        h = self.inp(x)
+        for layer in self.layers:
+            h = layer(h)
+        return self.out(h)
+
+
+class TemporalConvModule(nn.Module):
+    """Multi-stage temporal convolutional network (MS-TCN).
+
+    Parameters
+    ----------
+    n_inputs : int
+        Features per frame.
+    n_outputs : int
+        Classes.
+    channels : int, default=64
+        Feature maps of every layer.
+    n_layers : int, default=8
+        Dilated residual layers per stage (dilations 1, 2, 4, ...); the
+        receptive field of a stage is ``2 ** (n_layers + 1) - 1`` frames.
+    n_stages : int, default=2
+        The first stage plus refinement stages.
+    dropout : float, default=0.3
+        Drop probability inside the residual layers.
+    """
+
+    def __init__(
+        self, n_inputs, n_outputs, channels=64, n_layers=8, n_stages=2, dropout=0.3
+    ):
+        super().__init__()
+        self.stages = nn.ModuleList(
+            _Stage(
+                n_inputs if k == 0 else n_outputs,
+                n_outputs,
+                channels,
+                n_layers,
+                dropout,
+            )
+            for k in range(n_stages)
+        )
+
+    def forward(self, X):
+        out = self.stages[0](X.transpose(1, 2))
+        outputs = [out]
+        for stage in self.stages[1:]:
+            out = stage(F.softmax(out, dim=1))
+            outputs.append(out)
+        return tuple(o.transpose(1, 2) for o in outputs)

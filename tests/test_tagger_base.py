@@ -1,0 +1,195 @@
+"""What every tagger shares: one training loop, one untracked-rows rule, one decoding.
+
+BiLSTMTagger (Method C) and SequenceTagger differ only in their sampler (the
+paper's windows, random crops), their optimiser and schedule, and their module;
+these tests hold both to the shared behaviour.
+"""
+
+import threading
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+pytest.importorskip("skorch")
+torch = pytest.importorskip("torch")
+
+from sklearn.base import clone  # noqa: E402
+
+from skgesture import BiLSTMTagger, SequenceTagger  # noqa: E402
+from skgesture._bilstm import _SequenceHoldout  # noqa: E402
+from skgesture._networks import FramewiseLoss, held_out_sequences  # noqa: E402
+from skgesture._tagger import _HoldOutSequences  # noqa: E402
+
+TAGGERS = {
+    "bilstm": lambda **p: BiLSTMTagger(hidden_sizes=(4,), max_epochs=2, **p),
+    "sequence": lambda **p: SequenceTagger(
+        hidden_sizes=(4,), max_epochs=2, steps_per_epoch=2, crop_length=32, **p
+    ),
+}
+
+
+@pytest.fixture(autouse=True)
+def _one_torch_thread():
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(before)
+
+
+def _streams(n=4, seed=0):
+    """4-D streams: rest is noise, gesture 1 a bump on the first feature."""
+    rng = np.random.RandomState(seed)
+    X, y = [], []
+    for _ in range(n):
+        x = rng.normal(0, 0.2, (60, 4)).astype(np.float32)
+        lab = np.zeros(60, dtype=np.int64)
+        x[20:40, 0] += 1.5
+        lab[20:40] = 1
+        X.append(x)
+        y.append(lab)
+    return X, y
+
+
+class _SaysGesture(torch.nn.Module):
+    """Stand-in network whose logits favour class index 1 everywhere."""
+
+    def __init__(self, n_classes):
+        super().__init__()
+        self.bias = torch.nn.Parameter(torch.zeros(n_classes))
+        with torch.no_grad():
+            self.bias[1] = 5.0
+
+    def forward(self, X):
+        return self.bias.expand(*X.shape[:2], -1)
+
+
+@pytest.fixture(params=sorted(TAGGERS))
+def gesture_everywhere(request):
+    """A fitted tagger of each kind whose network says "gesture" on every frame."""
+    X, y = _streams()
+    tagger = TAGGERS[request.param](random_state=0).fit(X, y)
+    tagger.net_.module_ = _SaysGesture(len(tagger.classes_))
+    return tagger
+
+
+@pytest.mark.parametrize("span", [1, 9])
+def test_untracked_rows_are_rest_after_the_smoothing(gesture_everywhere, span):
+    tagger = gesture_everywhere.set_params(smooth_span=span, min_run=1)
+    x = np.ones((50, 4), dtype=np.float32)
+    mask = np.zeros(x.shape, dtype=bool)
+    mask[20:30] = True
+    masked = np.ma.MaskedArray(x, mask=mask)
+    zeroed = x.copy()
+    zeroed[20:30] = 0.0  # all-zero rows of a plain array are untracked too
+    for data in (masked, zeroed):
+        proba = tagger.predict_proba([data])[0]
+        assert_array_equal(proba[20:30], [[1.0, 0.0]] * 10)
+        # Rest is set after the smoothing: the neighbours stay gestures.
+        assert_array_equal(
+            tagger.predict([data])[0], np.r_[[1] * 20, [0] * 10, [1] * 20]
+        )
+        segs = tagger.predict_segments([data])[0]
+        assert_array_equal(segs[:, :3], [[1, 0, 20], [1, 30, 50]])
+        if isinstance(tagger, BiLSTMTagger):  # its smoothed scores, public
+            scores = tagger.decision_function([data])[0]
+            assert_array_equal(scores[20:30], [[1.0, 0.0]] * 10)
+            tracked = tagger.decision_function([x])[0]
+            assert_array_equal(scores[:20], tracked[:20])
+            assert_array_equal(scores[30:], tracked[30:])
+    assert (tagger.predict([np.zeros_like(x)])[0] == 0).all()
+
+
+def test_untracked_rows_count_before_min_run(gesture_everywhere):
+    tagger = gesture_everywhere.set_params(smooth_span=1, min_run=15)
+    x = np.ones((50, 4), dtype=np.float32)
+    x[10:20] = 0.0  # leaves a 10-frame remnant, shorter than min_run
+    assert_array_equal(tagger.predict([x])[0], np.r_[[0] * 20, [1] * 30])
+
+
+@pytest.mark.parametrize("kind", sorted(TAGGERS))
+def test_fit_leaves_the_global_torch_rng_alone(kind):
+    X, y = _streams(2)
+    torch.manual_seed(123)
+    expected = torch.rand(3)
+    torch.manual_seed(123)
+    TAGGERS[kind](random_state=0).fit(X, y)
+    assert_array_equal(torch.rand(3), expected)
+
+
+@pytest.mark.parametrize("kind", sorted(TAGGERS))
+def test_fits_in_parallel_threads_keep_their_seeds(kind):
+    X, y = _streams(3)
+    make = TAGGERS[kind]
+    expected = [make(random_state=s).fit(X, y).predict_proba(X[:1])[0] for s in (0, 1)]
+    found = [None, None]
+
+    def fit(k):
+        found[k] = make(random_state=k).fit(X, y).predict_proba(X[:1])[0]
+
+    threads = [threading.Thread(target=fit, args=(k,)) for k in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(expected, found):
+        assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("kind", sorted(TAGGERS))
+def test_early_stopping_holds_out_whole_sequences(kind):
+    X, y = _streams(4)
+    tagger = TAGGERS[kind](random_state=0, early_stopping=True, n_iter_no_change=1)
+    history = tagger.fit(X, y).net_.history
+    assert "valid_loss" in history[-1]
+    assert dict(tagger.net_.callbacks_)["early_stopping"].load_best
+    with pytest.raises(ValueError, match="at least 2 training sequences"):
+        clone(tagger).fit(X[:1], y[:1])
+
+
+def test_both_samplers_hold_out_the_same_sequences():
+    # Windows of 6 sequences (several per sequence) and the 6 sequences whole.
+    seq = np.repeat(np.arange(6), [3, 1, 4, 2, 2, 5])
+    _, valid = _SequenceHoldout(0.34, seq, 7)(list(range(len(seq))))
+    held = np.unique(seq[valid.indices])
+
+    class _Data:
+        X = [np.zeros((5, 2), np.float32)] * 6
+        y = [np.zeros(5, np.int64)] * 6
+        crop_length, augmenter = 4, None
+        mean, scale = np.zeros(2), np.ones(2)
+
+    _, whole = _HoldOutSequences(0.34, 7)(_Data())
+    assert len(whole) == len(held) == 2
+    assert sorted(held) == sorted(held_out_sequences(6, 0.34, 7))
+
+
+@pytest.mark.parametrize("kind, bar_at_1", [("bilstm", False), ("sequence", True)])
+def test_verbosity(kind, bar_at_1, capsys):
+    X, y = _streams(2)
+    TAGGERS[kind](random_state=0).fit(X, y)
+    assert capsys.readouterr() == ("", "")
+    TAGGERS[kind](random_state=0, verbose=1).fit(X, y)
+    out, err = capsys.readouterr()
+    # Method C prints its epochs from 1; the other taggers show a bar at 1.
+    assert ("train_loss" in out) != bar_at_1 and ("epoch" in err) == bar_at_1
+    TAGGERS[kind](random_state=0, verbose=2).fit(X, y)
+    assert "train_loss" in capsys.readouterr().out
+
+
+def test_framewise_loss_leaves_out_ignored_frames_and_adds_up_stages():
+    torch.manual_seed(0)
+    logits = torch.randn(2, 6, 3)
+    target = torch.tensor([[0, 1, 2, 0, 1, 2], [2, 0, 1, -100, -100, -100]])
+    keep = target.reshape(-1) != -100
+    ref = torch.nn.functional.cross_entropy(
+        logits.reshape(-1, 3)[keep], target.reshape(-1)[keep]
+    )
+    assert torch.allclose(FramewiseLoss()(logits, target), ref)
+    assert torch.allclose(FramewiseLoss()((logits, logits), target), 2 * ref)
+    weighted = FramewiseLoss(class_weight=[1.0, 0.0, 0.0])(logits, target)
+    rest = target.reshape(-1)[keep] == 0
+    ref0 = torch.nn.functional.cross_entropy(
+        logits.reshape(-1, 3)[keep][rest], target.reshape(-1)[keep][rest]
+    )
+    assert torch.allclose(weighted, ref0)
