@@ -1,6 +1,7 @@
 """The baseline a practitioner tries first: a forest on framewise joint features.
 
-Per frame: root-centred joint positions and velocities of the frames at
+Per frame: root-centred positions and velocities of the joints of ``joints`` (the
+20 Kinect v1 joints or the paper's 11) of the frames at
 ``t - half_window .. t + half_window`` (every ``step`` frames), a scikit-learn
 random forest over all frames (rest included), class probabilities averaged over
 ``smooth`` frames, arg-max, and runs shorter than ``min_run`` set to rest.
@@ -11,13 +12,19 @@ from scipy.ndimage import uniform_filter1d
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.ensemble import RandomForestClassifier
 
+from skgesture.layouts import KINECT_V1, PAPER_11
 from skgesture.utils import remove_short_runs
 from skgesture.utils._validation import check_sequence_labels, check_sequences
 
+_JOINTS = {
+    "full20": list(range(len(KINECT_V1.joint_names))),
+    "paper11": [KINECT_V1.joint_names.index(j) for j in PAPER_11.joints],
+}
 
-def _frame_features(seq, half_window, step):
-    q = np.nan_to_num(seq).copy()
-    q -= q[:, :1]  # root-centre (HipCenter is joint 0)
+
+def _frame_features(seq, half_window, step, joints="full20"):
+    q = np.nan_to_num(seq)
+    q = q[:, _JOINTS[joints]] - q[:, :1]  # root-centre (HipCenter is joint 0)
     T = len(q)
     flat = q.reshape(T, -1)
     vel = np.gradient(flat, axis=0) if T > 1 else np.zeros_like(flat)
@@ -33,6 +40,7 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
     def __init__(
         self,
         *,
+        joints="full20",
         n_estimators=100,
         half_window=4,
         step=2,
@@ -41,6 +49,7 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
         n_jobs=2,
         random_state=None,
     ):
+        self.joints = joints
         self.n_estimators = n_estimators
         self.half_window = half_window
         self.step = step
@@ -52,7 +61,13 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
     def fit(self, X, y):
         X = check_sequences(X, ndim=3, allow_nan=True)
         y = check_sequence_labels(y, X)
-        F = np.concatenate([_frame_features(s, self.half_window, self.step) for s in X])
+        if self.joints not in _JOINTS:
+            raise ValueError(
+                f"joints must be one of {sorted(_JOINTS)}, got {self.joints!r}"
+            )
+        F = np.concatenate(
+            [_frame_features(s, self.half_window, self.step, self.joints) for s in X]
+        )
         self.forest_ = RandomForestClassifier(
             n_estimators=self.n_estimators,
             n_jobs=self.n_jobs,
@@ -67,7 +82,7 @@ class SlidingWindowForest(ClassifierMixin, BaseEstimator):
         out = []
         for s in X:
             p = self.forest_.predict_proba(
-                _frame_features(s, self.half_window, self.step)
+                _frame_features(s, self.half_window, self.step, self.joints)
             )
             p = uniform_filter1d(p, self.smooth, axis=0, mode="nearest")
             lab = self.classes_[np.argmax(p, axis=1)]

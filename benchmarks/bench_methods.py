@@ -44,9 +44,13 @@ def _tuned_b(joints, random_state, memory_dir):
     return GridSearchCV(model, TUNING_GRID, scoring=jaccard_scorer, cv=GroupKFold(2))
 
 
-def _methods(joints, random_state, include, memory_dir):
+def method_factories(joints, random_state, include, memory_dir):
+    """``{name: make}`` for the methods of ``include``; ``make()`` builds one unfitted.
+
+    Shared with the side-by-side section (``bench_compare.py``).
+    """
     out = {
-        "forest": lambda: SlidingWindowForest(random_state=random_state),
+        "forest": lambda: SlidingWindowForest(joints=joints, random_state=random_state),
         "A": lambda: make_method_a(joints=joints, random_state=random_state),
         "B": lambda: make_method_b(joints=joints, random_state=random_state),
         "B (tuned)": lambda: _tuned_b(joints, random_state, memory_dir),
@@ -55,7 +59,13 @@ def _methods(joints, random_state, include, memory_dir):
     return {name: out[name] for name in include}
 
 
-def _evaluate(make, X_tr, y_tr, X_te, y_te, groups_tr):
+def evaluate(make, X_tr, y_tr, X_te, y_te, groups_tr, groups_te=None):
+    """Fit ``make()`` on the training part, score it on the test part.
+
+    Returns official and fp-penalised Jaccard, frame accuracy, fit seconds and
+    prediction µs per frame (and the segmenter's accuracy for A and B). With
+    ``groups_te``, also ``per_subject``: ``{subject: official Jaccard}``.
+    """
     est = make()
     t0 = time.perf_counter()
     if isinstance(est, GridSearchCV):
@@ -73,6 +83,13 @@ def _evaluate(make, X_tr, y_tr, X_te, y_te, groups_tr):
         "fit_s": fit_s,
         "pred_us_per_frame": 1e6 * pred_s / sum(len(x) for x in X_te),
     }
+    if groups_te is not None:
+        per_seq = jaccard_index(y_te, pred, per_sequence=True)
+        groups_te = np.asarray(groups_te)
+        row["per_subject"] = {
+            str(g): float(np.nanmean(per_seq[groups_te == g]))
+            for g in np.unique(groups_te)
+        }
     if isinstance(est, GridSearchCV):
         est = est.best_estimator_
     if hasattr(est, "named_steps") and "segmenter" in est.named_steps:
@@ -86,7 +103,8 @@ def _mean_rows(rows):
     return {k: float(np.mean([r[k] for r in rows])) for k in keys}
 
 
-def _split(data, tr, te):
+def split_data(data, tr, te):
+    """``(X_tr, y_tr, X_te, y_te, groups_tr)`` of a dataset Bunch."""
     return (
         [data.X[i] for i in tr],
         [data.y[i] for i in tr],
@@ -96,17 +114,40 @@ def _split(data, tr, te):
     )
 
 
+def precog_folds(data, quick=False):
+    """Leave-one-subject-out folds of PRECOG, in subject order (2 when quick)."""
+    groups = np.asarray(data.groups)
+    folds = list(LeaveOneGroupOut().split(data.X, groups=groups))
+    return folds[:2] if quick else folds
+
+
+def synthetic_split(quick=False, random_state=0):
+    """Synthetic streams and a ``(train, test)`` split with unseen test subjects.
+
+    100 training and 50 test sequences (30 / 15 when quick), 5 per subject.
+    """
+    n_train, n_test = (30, 15) if quick else (100, 50)
+    data = make_gesture_streams(
+        n_train + n_test, n_subjects=(n_train + n_test) // 5, random_state=random_state
+    )
+    groups = np.asarray(data.groups)
+    # Unseen subjects: the last subjects go to the test set.
+    test_subjects = np.unique(groups)[-(n_test // 5) :]
+    te = np.flatnonzero(np.isin(groups, test_subjects))
+    tr = np.flatnonzero(~np.isin(groups, test_subjects))
+    return data, tr, te
+
+
 def precog_rows(quick=False, include=DEFAULT_METHODS, random_state=0):
     """PRECOG (bundled subjects 1-8), leave-one-subject-out, 20 joints."""
     data = load_precog()
-    groups = np.asarray(data.groups)
-    folds = list(LeaveOneGroupOut().split(data.X, groups=groups))
-    if quick:
-        folds = folds[:2]
+    folds = precog_folds(data, quick)
     rows = []
     with tempfile.TemporaryDirectory() as memory_dir:
-        for name, make in _methods("full20", random_state, include, memory_dir).items():
-            per_fold = [_evaluate(make, *_split(data, tr, te)) for tr, te in folds]
+        for name, make in method_factories(
+            "full20", random_state, include, memory_dir
+        ).items():
+            per_fold = [evaluate(make, *split_data(data, tr, te)) for tr, te in folds]
             rows.append(
                 {
                     "data": f"PRECOG LOSO ({len(folds)} folds)",
@@ -119,21 +160,13 @@ def precog_rows(quick=False, include=DEFAULT_METHODS, random_state=0):
 
 def synthetic_rows(quick=False, include=DEFAULT_METHODS, random_state=0):
     """Synthetic streams: 100 training sequences, 50 test sequences of new subjects."""
-    n_train, n_test = (30, 15) if quick else (100, 50)
-    data = make_gesture_streams(
-        n_train + n_test, n_subjects=(n_train + n_test) // 5, random_state=random_state
-    )
-    groups = np.asarray(data.groups)
-    # Unseen subjects: the last subjects go to the test set.
-    test_subjects = np.unique(groups)[-(n_test // 5) :]
-    te = np.flatnonzero(np.isin(groups, test_subjects))
-    tr = np.flatnonzero(~np.isin(groups, test_subjects))
+    data, tr, te = synthetic_split(quick, random_state)
     rows = []
     with tempfile.TemporaryDirectory() as memory_dir:
-        for name, make in _methods(
+        for name, make in method_factories(
             "paper11", random_state, include, memory_dir
         ).items():
-            row = _evaluate(make, *_split(data, tr, te))
+            row = evaluate(make, *split_data(data, tr, te))
             rows.append(
                 {"data": f"synthetic {len(tr)}/{len(te)}", "method": name, **row}
             )

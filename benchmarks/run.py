@@ -22,6 +22,12 @@ SECTIONS = {
         "GridSearchCV over decision parameters: cache on vs off",
     ),
     "streaming": ("bench_streaming", "Streaming recognition: latency and delay"),
+    "predict": ("bench_predict", "Prediction cost per frame, Methods A and B"),
+    "scale": ("bench_scale", "Scale"),
+    "compare": (
+        "bench_compare",
+        "skgesture beside the peers (seed means; cached in bench_results/compare)",
+    ),
 }
 
 
@@ -48,7 +54,15 @@ def main(argv=None):
         module_name, title = SECTIONS[name.strip()]
         module = importlib.import_module(module_name)
         rows = module.run(quick=args.quick)
-        table = format_table(rows, getattr(module, "COLUMNS", None), title)
+        if hasattr(module, "format_tables"):  # sections with their own columns
+            table = module.format_tables(rows, title)
+        else:
+            table = format_table(rows, getattr(module, "COLUMNS", None), title)
+        notes = getattr(module, "NOTES", ())
+        if notes:
+            table += "\n" + "".join(f"* {note}\n" for note in notes)
+        quick = " --quick" if args.quick else ""
+        table += f"\ncommand: python benchmarks/run.py --only {name.strip()}{quick}\n"
         print(table, flush=True)
         chunks.append(table)
     if args.out:

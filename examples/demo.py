@@ -1,7 +1,7 @@
 """
-=====================================
+======================================
 skgesture demo: data, training, tuning
-=====================================
+======================================
 
 What ``make demo`` runs. It
 
@@ -25,7 +25,12 @@ import numpy as np
 from joblib import Memory
 from sklearn.model_selection import GridSearchCV, GroupKFold
 
-from skgesture import PoseDescriptor, make_method_a, make_method_b
+from skgesture import (
+    PoseDescriptor,
+    TorchMLPClassifier,
+    make_method_a,
+    make_method_b,
+)
 from skgesture.datasets import load_precog, make_gesture_streams
 from skgesture.metrics import frame_accuracy, jaccard_index, jaccard_scorer
 
@@ -50,18 +55,30 @@ def summarise(name, data):
     print(f"  per class: {per_class}")
 
 
-def make_pipeline(method, random_state, memory):
-    if method == "A":
-        return make_method_a(joints="full20", memory=memory, random_state=random_state)
-    if method == "B":
-        return make_method_b(joints="full20", memory=memory, random_state=random_state)
-    from skgesture import make_method_c
+def make_pipeline(method, random_state, memory, fast=False):
+    if method == "C":
+        from skgesture import make_method_c
 
-    return make_method_c(joints="full20", memory=memory, random_state=random_state)
+        model = make_method_c(joints="full20", memory=memory, random_state=random_state)
+        return model.set_params(tagger__max_epochs=5) if fast else model
+    make = make_method_a if method == "A" else make_method_b
+    model = make(joints="full20", memory=memory, random_state=random_state)
+    if fast:  # small networks, fewer epochs: the same steps in seconds
+        model.set_params(
+            segmenter__estimator=TorchMLPClassifier(
+                hidden_layer_sizes=(32,), activations=("tanh",), max_epochs=100
+            ),
+            classifier__estimator=TorchMLPClassifier(
+                hidden_layer_sizes=(64,), activations=("tanh",), max_epochs=100
+            ),
+        )
+    return model
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[1])
+    parser = argparse.ArgumentParser(
+        description="skgesture demo: data, training, tuning"
+    )
     parser.add_argument(
         "--method",
         choices=["A", "B", "C"],
@@ -72,6 +89,11 @@ def main(argv=None):
         "--no-search", action="store_true", help="skip the GridSearchCV example"
     )
     parser.add_argument("--random-state", type=int, default=0)
+    parser.add_argument(
+        "--fast",
+        action="store_true",
+        help="small networks (what the docs build runs; lower scores)",
+    )
     args = parser.parse_args(argv)
 
     # %%
@@ -101,7 +123,7 @@ def main(argv=None):
     X_te, y_te = [precog.X[i] for i in test], [precog.y[i] for i in test]
     with tempfile.TemporaryDirectory() as cache:
         memory = Memory(cache, verbose=0)
-        model = make_pipeline(args.method, args.random_state, memory)
+        model = make_pipeline(args.method, args.random_state, memory, args.fast)
         t0 = time.perf_counter()
         model.fit(X_tr, y_tr)
         fit_s = time.perf_counter() - t0

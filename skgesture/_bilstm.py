@@ -1,4 +1,12 @@
-"""BiLSTMTagger: framewise bidirectional LSTM tagger of every frame (Method C)."""
+"""BiLSTMTagger: framewise bidirectional LSTM tagger of every frame (Method C).
+
+What is Method C's own lives here: the paper's training windows (the sampler),
+its SGD optimiser and step schedule, and its chunked inference. The rest is
+shared with the other taggers: the network is a
+:class:`~skgesture._modules.RecurrentTaggerModule`, the training loop is
+:class:`~skgesture._networks.FramewiseNetwork`'s, and input checks, untracked
+rows and the decoding come from :class:`~skgesture._tagger._BaseTagger`.
+"""
 
 # SPDX-License-Identifier: BSD-3-Clause
 
@@ -6,30 +14,36 @@ from numbers import Integral, Real
 
 import numpy as np
 import torch
-from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
+from sklearn.base import _fit_context
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
-from skorch import NeuralNet
-from skorch.callbacks import EarlyStopping, LRScheduler
-from torch import nn
-from torch.nn import functional as F
+from skorch.callbacks import LRScheduler
 
-from skgesture._networks import fit_cached, seed_from, torch_threads
-from skgesture.utils._segments import labels_to_segments, remove_short_runs
-from skgesture.utils._smoothing import loess_smooth
-from skgesture.utils._validation import check_sequence_labels, check_sequences
+from skgesture._decoding import smooth_proba
+from skgesture._modules import RecurrentTaggerModule, frame_probabilities
+from skgesture._networks import (  # noqa: F401 - _silent: sink of old pickles
+    IGNORE_INDEX,
+    FramewiseLoss,
+    FramewiseNetwork,
+    _silent,
+    held_out_sequences,
+    seed_from,
+)
+from skgesture._tagger import _BaseTagger, _rest_where
+from skgesture.utils._validation import SequenceOf
 
 __all__ = ["BiLSTMTagger", "sample_windows"]
 
-# METHOD_SPEC §7.1: training windows
+# docs/method.md §7.1: training windows
 WINDOW = 10
 REST_STEP = 5
 GESTURE_STEP = 2
-# METHOD_SPEC §7.2: network
-LEAKY_SLOPE = 0.01
+# docs/method.md §7.2: network, a RecurrentTaggerModule of BiLSTMs with LeakyReLU
+# (0.01) and dropout between them, initialised as MATLAB does
+PAPER_MODULE = {"cell": "lstm", "activation": "leaky_relu", "init": "matlab"}
 PAPER_HIDDEN_SIZES = (1024, 1024, 512)
 PAPER_DROPOUT = 0.6
-# METHOD_SPEC §7.3: optimiser and schedule
+# docs/method.md §7.3: optimiser and schedule
 LEARNING_RATE = 0.01
 MOMENTUM = 0.9
 WEIGHT_DECAY = 1e-4
@@ -37,7 +51,7 @@ LR_DROP_FACTOR = 0.85
 LR_DROP_PERIOD = 10
 BATCH_SIZE = 128
 PAPER_MAX_EPOCHS = 150
-# METHOD_SPEC §7.4 and decision D12: decision rules
+# docs/method.md §7.4 and decision D12: decision rules
 MIN_RUN = 15
 SMOOTH_SPAN = 15
 # CPU-sized default network (measured in the BiLSTMTagger Notes)
@@ -47,12 +61,11 @@ CPU_MAX_EPOCHS = 40
 
 VALIDATION_FRACTION = 0.1
 N_ITER_NO_CHANGE = 10
-IGNORE_INDEX = -100  # padded frames of a training sequence shorter than a window
 PREDICT_BATCH = 4096  # chunks per forward pass at prediction
 
 
 def sample_windows(y, window=WINDOW, rest_step=REST_STEP, gesture_step=GESTURE_STEP):
-    """Start frames of the training windows of one sequence (METHOD_SPEC §7.1).
+    """Start frames of the training windows of one sequence (docs/method.md §7.1).
 
     The first window starts at frame 0. After the window starting at ``t``, the
     next one starts at ``t + rest_step`` if all its ``window`` frames are rest
@@ -103,7 +116,7 @@ def _training_windows(X, y, window, rest_step, gesture_step):
 
     A sequence shorter than ``window`` gives one window padded on the right with
     zero frames whose targets are ``IGNORE_INDEX`` (MATLAB pads with 0 on the
-    right, METHOD_SPEC §7.3; the loss skips the padding).
+    right, docs/method.md §7.3; the loss skips the padding).
     """
     n_features = X[0].shape[1]
     Xw, yw, seq = [], [], []
@@ -124,7 +137,7 @@ def _training_windows(X, y, window, rest_step, gesture_step):
 
 
 def _chunks(n_frames, window, overlap):
-    """``(start, end)`` of the inference chunks of a sequence (METHOD_SPEC §7.4).
+    """``(start, end)`` of the inference chunks of a sequence (docs/method.md §7.4).
 
     Without overlap: consecutive non-overlapping chunks, the last one shorter.
     With overlap: full windows every ``window // 2`` frames plus one ending at
@@ -148,98 +161,61 @@ def _predict_chunks(module, X, window, overlap, n_classes):
     together. Frames covered by several chunks (``overlap=True``) average them.
     """
     module.eval()
-    device = next(module.parameters()).device
     groups = {}
     for i, x in enumerate(X):
         for s, e in _chunks(len(x), window, overlap):
             groups.setdefault(e - s, []).append((i, s, e))
     sums = [np.zeros((len(x), n_classes)) for x in X]
     counts = [np.zeros((len(x), 1)) for x in X]
-    with torch.inference_mode():
-        for length, items in groups.items():
-            for b in range(0, len(items), PREDICT_BATCH):
-                batch = items[b : b + PREDICT_BATCH]
-                xb = np.stack([X[i][s:e] for i, s, e in batch]).astype(np.float32)
-                logits = module(torch.as_tensor(xb, device=device))
-                prob = torch.softmax(logits, dim=-1).cpu().numpy().astype(np.float64)
-                for (i, s, e), p in zip(batch, prob):
-                    sums[i][s:e] += p
-                    counts[i][s:e] += 1
+    for items in groups.values():
+        for b in range(0, len(items), PREDICT_BATCH):
+            batch = items[b : b + PREDICT_BATCH]
+            xb = np.stack([X[i][s:e] for i, s, e in batch]).astype(np.float32)
+            for (i, s, e), p in zip(batch, frame_probabilities(module, xb)):
+                sums[i][s:e] += p
+                counts[i][s:e] += 1
     return [s / c for s, c in zip(sums, counts)]
 
 
-class _BiLSTMModule(nn.Module):
-    """Stacked BiLSTMs, LeakyReLU + dropout between them, linear read-out per step.
-
-    Returns the logits of shape ``(batch, n_steps, n_outputs)``. Initialisation
-    follows MATLAB's defaults (METHOD_SPEC §7.2): Glorot-uniform input and
-    read-out weights, orthogonal recurrent weights, forget-gate bias 1, other
-    biases 0.
-    """
+class _BiLSTMModule(RecurrentTaggerModule):
+    """Method C's network as saved before it became a
+    :class:`~skgesture._modules.RecurrentTaggerModule`; kept so that those
+    files load (their ``lstms`` are the ``layers``). New taggers use
+    ``RecurrentTaggerModule(**PAPER_MODULE)`` directly."""
 
     def __init__(
         self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES, dropout=CPU_DROPOUT
     ):
-        super().__init__()
-        self.lstms = nn.ModuleList()
-        width = n_inputs
-        for size in hidden_sizes:
-            self.lstms.append(
-                nn.LSTM(width, size, batch_first=True, bidirectional=True)
-            )
-            width = 2 * size
-        self.activation = nn.LeakyReLU(LEAKY_SLOPE)
-        self.dropout = nn.Dropout(dropout)
-        self.head = nn.Linear(width, n_outputs)
-        self.reset_parameters()
-
-    def reset_parameters(self):
-        for lstm in self.lstms:
-            size = lstm.hidden_size
-            for name, param in lstm.named_parameters():
-                if name.startswith("weight_ih"):
-                    nn.init.xavier_uniform_(param)
-                elif name.startswith("weight_hh"):
-                    nn.init.orthogonal_(param)
-                elif name.startswith("bias_ih"):
-                    nn.init.zeros_(param)
-                    with torch.no_grad():
-                        param[size : 2 * size] = 1.0  # torch gate order i, f, g, o
-                else:  # bias_hh: the two biases add up
-                    nn.init.zeros_(param)
-        nn.init.xavier_uniform_(self.head.weight)
-        nn.init.zeros_(self.head.bias)
-
-    def forward(self, X):
-        out = X
-        for k, lstm in enumerate(self.lstms):
-            out, _ = lstm(out)
-            if k < len(self.lstms) - 1:
-                out = self.dropout(self.activation(out))
-        return self.head(out)
-
-
-class _StepCrossEntropy(nn.Module):
-    """Cross-entropy of every time step of ``(batch, n_steps, n_classes)`` logits.
-
-    ``time_reduction="sum"`` sums over the steps of a window and averages over
-    the windows of the batch (MATLAB's sequence loss, METHOD_SPEC §7.2);
-    ``"mean"`` averages over every step. Steps whose target is ``IGNORE_INDEX``
-    (padding) are skipped.
-    """
-
-    def __init__(self, time_reduction="sum"):
-        super().__init__()
-        self.time_reduction = time_reduction
-
-    def forward(self, logits, target):
-        flat = logits.reshape(-1, logits.shape[-1])
-        loss = F.cross_entropy(
-            flat, target.reshape(-1), ignore_index=IGNORE_INDEX, reduction="sum"
+        super().__init__(
+            n_inputs, n_outputs, hidden_sizes, dropout=dropout, **PAPER_MODULE
         )
-        if self.time_reduction == "sum":
-            return loss / target.shape[0]
-        return loss / (target != IGNORE_INDEX).sum().clamp(min=1)
+
+    def __setstate__(self, state):  # a pickled (joblib) tagger
+        modules = state.get("_modules", {})
+        if "lstms" in modules:
+            state["_modules"] = type(modules)(
+                ("layers" if k == "lstms" else k, v) for k, v in modules.items()
+            )
+            state.setdefault("cell", "lstm")
+        super().__setstate__(state)
+
+    def load_state_dict(self, state_dict, *args, **kwargs):  # a model file
+        state_dict = {
+            ("layers." + k[len("lstms.") :] if k.startswith("lstms.") else k): v
+            for k, v in state_dict.items()
+        }
+        return super().load_state_dict(state_dict, *args, **kwargs)
+
+
+class _StepCrossEntropy(FramewiseLoss):
+    """Method C's loss as saved before it became a
+    :class:`~skgesture._networks.FramewiseLoss`; kept so that those files
+    load."""
+
+    def __setstate__(self, state):
+        state.setdefault("smoothing_weight", 0.0)
+        super().__setstate__(state)
+        self._buffers.setdefault("weight", None)
 
 
 class _SequenceHoldout:
@@ -256,9 +232,7 @@ class _SequenceHoldout:
 
     def __call__(self, dataset, y=None, **kwargs):
         ids = np.unique(self.sequence_ids)
-        rng = np.random.RandomState(self.random_state)
-        n_valid = min(max(int(round(self.fraction * len(ids))), 1), len(ids) - 1)
-        held = rng.choice(ids, n_valid, replace=False)
+        held = ids[held_out_sequences(len(ids), self.fraction, self.random_state)]
         valid = np.isin(self.sequence_ids, held)
         return (
             torch.utils.data.Subset(dataset, np.flatnonzero(~valid)),
@@ -266,18 +240,19 @@ class _SequenceHoldout:
         )
 
 
-def _silent(*args, **kwargs):
-    """A skorch ``sink`` that prints nothing."""
-
-
-class _BiLSTMNet(BaseEstimator):
+class _BiLSTMNet(FramewiseNetwork):
     """The trainable part of :class:`BiLSTMTagger`, cached by ``fit_cached``.
 
     Its parameters are the network and training parameters only, so decision
     parameters of the tagger never change the cache key. ``fit`` takes the
     validated sequences and the labels encoded as class indices, and sets
-    ``net_`` (the trained skorch ``NeuralNet``) and ``n_windows_``.
+    ``net_`` (the trained skorch ``NeuralNet``) and ``n_windows_``. The
+    training loop is :class:`FramewiseNetwork`'s; the sampler gives the
+    paper's windows (docs/method.md §7.1), the optimiser is SGD with momentum
+    and a step schedule (§7.3).
     """
+
+    _epoch_lines_from = 1  # verbose >= 1 prints one line per epoch
 
     def __init__(
         self,
@@ -329,7 +304,7 @@ class _BiLSTMNet(BaseEstimator):
             X, y, self.window, self.rest_step, self.gesture_step
         )
         seed = seed_from(self.random_state)
-        callbacks = [
+        schedule = [
             (
                 "lr_scheduler",
                 LRScheduler(
@@ -339,60 +314,38 @@ class _BiLSTMNet(BaseEstimator):
                 ),
             ),
         ]
-        train_split = None
-        if self.early_stopping:
-            if len(X) < 2:
-                raise ValueError(
-                    "early_stopping holds out whole sequences for validation and "
-                    f"needs at least 2 training sequences, got {len(X)}"
-                )
-            train_split = _SequenceHoldout(self.validation_fraction, seq, seed)
-            callbacks.append(
-                (
-                    "early_stopping",
-                    EarlyStopping(
-                        monitor="valid_loss",
-                        patience=self.n_iter_no_change,
-                        load_best=True,
-                        sink=print if self.verbose else _silent,
-                    ),
-                )
-            )
-        self.net_ = NeuralNet(
-            _BiLSTMModule,
-            module__n_inputs=Xw.shape[2],
-            module__n_outputs=self.n_classes,
-            module__hidden_sizes=tuple(self.hidden_sizes),
-            module__dropout=self.dropout,
-            criterion=_StepCrossEntropy,
-            criterion__time_reduction=self.time_reduction,
+        self.net_ = self._train(
+            RecurrentTaggerModule,
+            Xw,
+            yw,
+            seed=seed,
+            n_sequences=len(X),
+            train_split=_SequenceHoldout(self.validation_fraction, seq, seed),
+            callbacks=schedule,
+            module_params={
+                "n_inputs": Xw.shape[2],
+                "n_outputs": self.n_classes,
+                "hidden_sizes": tuple(self.hidden_sizes),
+                "dropout": self.dropout,
+                **PAPER_MODULE,
+            },
+            criterion_params={"time_reduction": self.time_reduction},
             optimizer=torch.optim.SGD,
             optimizer__momentum=self.momentum,
             optimizer__weight_decay=self.weight_decay,
-            # L2 on weights only: MATLAB's bias L2 factor is 0 (METHOD_SPEC §7.3)
+            # L2 on weights only: MATLAB's bias L2 factor is 0 (docs/method.md §7.3)
             optimizer__param_groups=[("*bias*", {"weight_decay": 0.0})],
-            lr=self.learning_rate,
-            max_epochs=self.max_epochs,
-            batch_size=self.batch_size,
             iterator_train__shuffle=True,
-            train_split=train_split,
-            callbacks=callbacks,
-            device=self.device,
-            verbose=int(self.verbose > 0),
         )
-        on_gpu = str(self.device).startswith("cuda")
-        with torch.random.fork_rng(devices=None if on_gpu else []):
-            torch.manual_seed(seed)  # initialisation, dropout and window shuffling
-            self.net_.fit(Xw, yw)
         self.n_windows_ = len(Xw)
         return self
 
 
-class BiLSTMTagger(ClassifierMixin, BaseEstimator):
+class BiLSTMTagger(_BaseTagger):
     """Bidirectional LSTM labelling every frame of a stream (Method C).
 
     Segments and names gestures in one pass, without a segmentation stage
-    (METHOD_SPEC §7). Training cuts every sequence into windows of ``window``
+    (docs/method.md §7). Training cuts every sequence into windows of ``window``
     frames (the next window starts ``rest_step`` frames later after an all-rest
     window, ``gesture_step`` otherwise) and trains stacked bidirectional LSTMs,
     each but the last followed by LeakyReLU(0.01) and dropout, with a linear
@@ -496,7 +449,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
 
     Notes
     -----
-    The rules follow METHOD_SPEC §7: windows §7.1, network §7.2, optimiser
+    The rules follow docs/method.md §7: windows §7.1, network §7.2, optimiser
     §7.3, inference §7.4 (per-frame output, last chunk shorter: decision D18),
     smoothing span decision D12. Differences from MATLAB: torch's SGD keeps
     its momentum buffer in gradient units, so after a learning-rate drop the
@@ -542,7 +495,7 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
     """
 
     _parameter_constraints: dict = {
-        "hidden_sizes": [tuple, list],
+        "hidden_sizes": [SequenceOf.ints(1)],
         "dropout": [Interval(Real, 0, 1, closed="left")],
         "window": [Interval(Integral, 1, None, closed="left")],
         "rest_step": [Interval(Integral, 1, None, closed="left")],
@@ -650,6 +603,10 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         params.update(overrides)
         return cls(**params)
 
+    # Decoding rules Method C fixes (read by the shared decoding path).
+    smoothing = "loess"  # MATLAB-style loess of span smooth_span
+    max_gap = 0  # no merging of split runs
+
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y):
         """Train the network on windows of every sequence.
@@ -667,35 +624,14 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         self : BiLSTMTagger
             The fitted tagger.
         """
-        hidden = self.hidden_sizes
-        if len(hidden) == 0 or not all(
-            isinstance(h, Integral) and not isinstance(h, bool) and h >= 1
-            for h in hidden
-        ):
-            raise ValueError(
-                "hidden_sizes must be a non-empty tuple of positive ints, got "
-                f"{hidden!r}"
-            )
-        X = check_sequences(X, ndim=2, estimator=self, reset=True)
-        y = check_sequence_labels(y, X)
-        classes, y_idx = np.unique(np.concatenate(y), return_inverse=True)
-        if classes[0] != 0:
-            raise ValueError(
-                "y has no rest frame (label 0): the tagger learns gestures against "
-                f"rest, got labels {classes.tolist()}"
-            )
-        if len(classes) < 2:
-            raise ValueError(
-                "y has no gesture frame (every label is 0): the tagger needs "
-                "labels 1..K as well as rest"
-            )
-        y_idx = np.split(y_idx.astype(np.int64), np.cumsum([len(v) for v in y])[:-1])
-        random_state = (
-            None if self.random_state is None else seed_from(self.random_state)
-        )
-        network = _BiLSTMNet(
-            n_classes=len(classes),
-            hidden_sizes=tuple(int(h) for h in hidden),
+        # The paper trains on every frame: untracked ones keep their labels.
+        X, y_idx, classes = self._validate_fit(X, y, ignore_untracked=False)
+        return self._fit_network(X, y_idx, classes)
+
+    def _network(self, n_classes):
+        return _BiLSTMNet(
+            n_classes=n_classes,
+            hidden_sizes=tuple(int(h) for h in self.hidden_sizes),
             dropout=self.dropout,
             window=self.window,
             rest_step=self.rest_step,
@@ -712,35 +648,20 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
             validation_fraction=self.validation_fraction,
             n_iter_no_change=self.n_iter_no_change,
             device=self.device,
-            random_state=random_state,
+            random_state=(
+                None if self.random_state is None else seed_from(self.random_state)
+            ),
             verbose=self.verbose,
         )
-        with torch_threads(self.n_threads):
-            fitted = fit_cached(self.memory, network, X, y_idx)
-        self.classes_ = classes
+
+    def _adopt(self, fitted):
         self.net_ = fitted.net_
         self.n_windows_ = fitted.n_windows_
-        return self
 
-    def predict_proba(self, X):
-        """Raw per-frame class probabilities (before smoothing).
-
-        Parameters
-        ----------
-        X : list of ndarray of shape (n_frames_i, n_features)
-            Per-frame features; any length >= 1.
-
-        Returns
-        -------
-        list of ndarray of shape (n_frames_i, n_classes)
-            Rows sum to 1; columns in ``classes_`` order.
-        """
-        check_is_fitted(self)
-        X = check_sequences(X, ndim=2, estimator=self, reset=False)
-        with torch_threads(self.n_threads):
-            return _predict_chunks(
-                self.net_.module_, X, self.window, self.overlap, len(self.classes_)
-            )
+    def _raw_proba(self, X):
+        return _predict_chunks(
+            self.net_.module_, X, self.window, self.overlap, len(self.classes_)
+        )
 
     def decision_function(self, X):
         """Loess-smoothed per-frame class probabilities.
@@ -754,82 +675,88 @@ class BiLSTMTagger(ClassifierMixin, BaseEstimator):
         -------
         list of ndarray of shape (n_frames_i, n_classes)
             Every class track smoothed with span ``smooth_span``; the arg-max
-            of a row is the frame's label before the ``min_run`` filter.
+            of a row is the frame's label before the ``min_run`` filter. An
+            untracked row is rest with score 1 (set after the smoothing).
         """
+        proba, untracked = self._proba(X)
         return [
-            np.asarray(loess_smooth(p, self.smooth_span, axis=0))
-            for p in self.predict_proba(X)
+            _rest_where(smooth_proba(p, self.smooth_span, self.smoothing), rows)
+            for p, rows in zip(proba, untracked)
         ]
 
-    def predict(self, X):
-        """Per-frame labels.
+    # -- incremental step (docs/design.md, "Incremental steps") ----------------
+    # The state (skgesture/_incremental.py, TaggerStream) runs the network on
+    # the chunks of predict_proba as they complete and applies the same loess,
+    # rest rule and minimum run.
+
+    def stream_init(self, **options):
+        """A fresh state for one live stream (docs/design.md, "Incremental steps").
 
         Parameters
         ----------
-        X : list of ndarray of shape (n_frames_i, n_features)
-            Per-frame features.
+        **options
+            Options of other stages, ignored.
 
         Returns
         -------
-        list of ndarray of shape (n_frames_i,)
-            Labels from ``classes_``; gesture runs shorter than ``min_run`` are
-            rest (0).
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        return [self._decide(s) for s in self.decision_function(X)]
+        from skgesture._incremental import TaggerStream
 
-    def predict_segments(self, X):
-        """Gesture instances with their confidence.
+        check_is_fitted(self)
+        return TaggerStream(self)
+
+    def stream_step(self, state, rows):
+        """Descriptor rows in; the gestures whose run ended out.
+
+        The network runs on each chunk of ``window`` frames as it completes
+        (the chunks of :meth:`predict_proba`), every class track is smoothed
+        by the causal loess, and a run of one gesture label of at least
+        ``min_run`` frames is emitted when the label changes. Untracked
+        (masked) rows are rest.
 
         Parameters
         ----------
-        X : list of ndarray of shape (n_frames_i, n_features)
-            Per-frame features.
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next descriptor rows.
 
         Returns
         -------
-        list of ndarray of shape (n_segments_i, 4)
-            Rows ``(class, start, end, confidence)``, 0-based, ``end``
-            exclusive; the confidence is the mean raw probability of the class
-            over the run.
+        out : list of StreamSegment
+            ``(label, start, end, confidence, time)`` of each gesture decided.
+        state : object
+            The updated state.
         """
-        out = []
-        for p in self.predict_proba(X):
-            labels = self._decide(np.asarray(loess_smooth(p, self.smooth_span, axis=0)))
-            rows = [
-                (c, s, e, float(p[s:e, np.searchsorted(self.classes_, c)].mean()))
-                for c, s, e in labels_to_segments(labels)
-            ]
-            out.append(np.array(rows, dtype=float).reshape(-1, 4))
-        return out
+        return state.step(rows), state
 
-    def score(self, X, y, sample_weight=None):
-        """Mean official ChaLearn 2014 Jaccard index.
+    def stream_flush(self, state):
+        """End of the stream: the last chunks, end-point fits, the last run.
 
         Parameters
         ----------
-        X : list of ndarray of shape (n_frames_i, n_features)
-            Per-frame features.
-        y : list of ndarray of shape (n_frames_i,)
-            True per-frame labels.
-        sample_weight : None
-            Not supported.
+        state : object
+            From :meth:`stream_init`.
 
         Returns
         -------
-        float
-            Mean Jaccard index over the sequences.
+        out : list of StreamSegment
+            The remaining gestures.
+        state : object
+            The spent state.
         """
-        from skgesture.metrics import jaccard_index
+        return state.flush(), state
 
-        return jaccard_index(y, self.predict(X))
+    @property
+    def stream_lookahead(self):
+        """Frames between a gesture's last frame and its event, at most.
 
-    def _decide(self, smoothed):
-        labels = self.classes_[np.argmax(smoothed, axis=1)]
-        return remove_short_runs(labels, self.min_run)
+        ``(smooth_span - 1) // 2 + window`` (17 with the defaults).
+        """
+        from skgesture._incremental import check_stream_span
 
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        tags.non_deterministic = self.device != "cpu"
-        return tags
+        return (check_stream_span(self.smooth_span, "smooth_span") - 1) // 2 + int(
+            self.window
+        )

@@ -12,6 +12,7 @@ the whole batch, writing each feature group into its rows of one output array.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import os
 import warnings
 from numbers import Real
 
@@ -26,19 +27,54 @@ from skgesture.layouts import (
     DescriptorJoints,
     get_descriptor_joints,
 )
-from skgesture.utils._validation import check_sequences, missing_frames
+from skgesture.utils._validation import (
+    MAX_COORDINATE,
+    check_sequences,
+    missing_frames,
+    refuse_set_output,
+)
 
 __all__ = ["PoseDescriptor"]
 
-GAUSSIAN_SIZE = 5  # METHOD_SPEC §3.6: fspecial('gaussian', [5 1], 1)
-DERIVATIVE_REACH = 2  # METHOD_SPEC §3.7: the acceleration looks 2 frames each way
+GAUSSIAN_SIZE = 5  # docs/method.md §3.6: fspecial('gaussian', [5 1], 1)
+DERIVATIVE_REACH = 2  # docs/method.md §3.7: the acceleration looks 2 frames each way
 EDGE = max((GAUSSIAN_SIZE - 1) // 2, DERIVATIVE_REACH)  # padding per sequence end
-MIN_NORM = 1e-8  # METHOD_SPEC §3.9-3.11: below this a vector is degenerate
-MIN_SCALE = 1e-8  # METHOD_SPEC §3.14: a feature with smaller std keeps scale 1
-DEGENERATE_INCLINATION = np.pi / 2  # METHOD_SPEC decision D8
+MIN_NORM = 1e-8  # docs/method.md §3.9-3.11: below this a vector is degenerate
+MIN_SCALE = 1e-8  # docs/method.md §3.14: a feature with smaller std keeps scale 1
+DEGENERATE_INCLINATION = np.pi / 2  # docs/method.md decision D8
 BATCH_VALUES = 750_000  # descriptor values per vectorised pass (4096 frames of
 # 183 features): large enough to amortise the Python overhead, small enough
 # for the intermediates to stay in cache
+
+
+_ROOT = KINECT_V1.index(KINECT_V1.root)
+# Whether the descriptor may use the compiled kernel (numba) when it is
+# installed; False forces the numpy implementation (tests compare the two).
+# SKGESTURE_DISABLE_NUMBA=1 in the environment sets it to False.
+USE_COMPILED = os.environ.get("SKGESTURE_DISABLE_NUMBA", "0") in ("", "0")
+
+
+def _compiled_kernel():
+    """The compiled descriptor kernel module, or None (numba missing or
+    ``USE_COMPILED`` False): the numpy implementation is used then."""
+    global USE_COMPILED
+    if not USE_COMPILED:
+        return None
+    try:
+        from skgesture import _descriptor_kernel
+    except ImportError:  # numba is an optional dependency
+        return None
+    except Exception as exc:  # e.g. numba finds no writable cache folder
+        USE_COMPILED = False
+        warnings.warn(
+            f"the compiled descriptor kernel is unavailable ({exc}); using the "
+            f"numpy implementation (same descriptor, slower). Setting "
+            f"NUMBA_CACHE_DIR to a writable folder may help.",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return None
+    return _descriptor_kernel
 
 
 def gaussian_kernel(sigma, size=GAUSSIAN_SIZE):
@@ -124,7 +160,9 @@ def _batches(lengths, size):
 
 
 def _fill_plan(missing, method):
-    """How to fill untracked frames (METHOD_SPEC §3.3, D11): ``(cols, prev, nxt, w)``.
+    """How to fill untracked frames: ``(cols, prev, nxt, w)``.
+
+    docs/method.md §3.3, decision D11.
 
     Untracked frame ``cols[i]`` becomes ``q[prev[i]] + w[i] * (q[nxt[i]] -
     q[prev[i]])``: ``"linear"`` interpolates between the nearest tracked frames
@@ -144,7 +182,7 @@ def _fill_plan(missing, method):
 
 
 def _fill_missing(q, missing, method):
-    """Fill the untracked frames of a ``(T, ...)`` sequence (METHOD_SPEC §3.3)."""
+    """Fill the untracked frames of a ``(T, ...)`` sequence (docs/method.md §3.3)."""
     if not missing.any():
         return q
     q = q.copy()
@@ -372,7 +410,7 @@ def _smallest_eigvec(cov):
 
 
 def _body_frame_planes(S, torso, left_right, spine, offsets=None):
-    """Per-frame body axes ``u_x, u_z`` (planes ``(3, n)``), METHOD_SPEC §3.8.
+    """Per-frame body axes ``u_x, u_z`` (planes ``(3, n)``), docs/method.md §3.8.
 
     ``S`` holds the joints as planes ``(3, K, n)``. ``offsets`` are the first
     frames of the sequences laid out back to back in ``S`` (``None``: a single
@@ -394,7 +432,7 @@ def _body_frame_planes(S, torso, left_right, spine, offsets=None):
     ok = ok_n & ok_y & ok_s
     if not ok.all():
         # Degenerate frames reuse the previous good frame's basis; camera axes
-        # before the first good frame of a sequence (METHOD_SPEC §3.8).
+        # before the first good frame of a sequence (docs/method.md §3.8).
         t = np.arange(len(ok))
         idx = np.maximum.accumulate(np.where(ok, t, -1))
         first = 0
@@ -414,7 +452,7 @@ def _body_frame(P, torso, left_right, spine):
 
 
 def _angles(S, triples, u_x, u_z, incl, azim, bend):
-    """Inclination, azimuth and bending angles (METHOD_SPEC §3.9-3.11).
+    """Inclination, azimuth and bending angles (docs/method.md §3.9-3.11).
 
     ``S`` holds the joints as planes ``(3, K, n)``, ``u_x, u_z`` the body axes
     ``(3, n)``; the angles are written into the rows of ``incl``, ``azim`` and
@@ -441,6 +479,25 @@ def _angles(S, triples, u_x, u_z, incl, azim, bend):
     _arccos(_dot(pos, u_z[:, None]), ok_p, 0.0, bend)
 
 
+def _mean_std(chunks):
+    """Per-column mean and (population) standard deviation of the rows of
+    ``chunks``, combined chunk by chunk (Chan, Golub & LeVeque's update, as
+    numerically sound as one pass over all rows)."""
+    n, mean, m2 = 0, 0.0, 0.0
+    for rows in chunks:
+        k = len(rows)
+        if k == 0:
+            continue
+        mean_k = rows.mean(axis=0)
+        m2_k = ((rows - mean_k) ** 2).sum(axis=0)
+        delta = mean_k - mean
+        total = n + k
+        mean = mean + delta * (k / total)
+        m2 = m2 + m2_k + delta**2 * (n * k / total)
+        n = total
+    return mean, np.sqrt(m2 / n)
+
+
 def _standardise(rows, mean, scale):
     """``(rows - mean) / scale`` in place, per row; nothing when ``mean`` is None."""
     if mean is not None:
@@ -461,7 +518,7 @@ def _pair_runs(pairs):
 
 
 def _distances_planes(S, runs, out):
-    """Joint distances of the pair ``runs`` (METHOD_SPEC §3.12) into ``out`` rows.
+    """Joint distances of the pair ``runs`` (docs/method.md §3.12) into ``out`` rows.
 
     ``S`` holds the joints as planes ``(3, K, n)``.
     """
@@ -486,7 +543,7 @@ def _distances(P, pairs):
 
 
 def _feature_groups(dj):
-    """Row slices of the feature groups of the layout (METHOD_SPEC §3.13):
+    """Row slices of the feature groups of the layout (docs/method.md §3.13):
     positions, velocities, accelerations, inclinations, azimuths, bendings and
     distances."""
     K, n_tri = dj.n_joints, len(dj.triples)
@@ -495,7 +552,7 @@ def _feature_groups(dj):
     return [slice(end - size, end) for size, end in zip(sizes, ends)]
 
 
-class PoseDescriptor(TransformerMixin, BaseEstimator):
+class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
     """Per-frame handcrafted pose descriptor of Brás, Simão & Neto.
 
     Turns each skeleton sequence ``(n_frames, 20, 3)`` (Kinect v1 joint order, in
@@ -504,8 +561,9 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
     accelerations, 9 inclination, 9 azimuth and 11 bending angles and 55 pairwise
     distances, z-scored with statistics of the training frames.
 
-    Processing per sequence: untracked frames (all zeros or NaN) are filled, the
-    skeleton is centred on HipCenter, every link is rescaled to its mean training
+    Processing per sequence: untracked frames (all zeros or NaN, or with a
+    masked value in a ``numpy.ma.MaskedArray`` input) are filled, the skeleton
+    is centred on HipCenter, every link is rescaled to its mean training
     length, the kept joints are smoothed along time by a 5-tap Gaussian, and
     derivatives and angles are computed from the smoothed positions.
 
@@ -519,7 +577,7 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         Standard deviation, in frames, of the 5-tap temporal Gaussian. ``0``
         disables smoothing.
     border : {"replicate", "zero", "symmetric"}, default="replicate"
-        Padding of the Gaussian at the sequence ends (METHOD_SPEC decision D3).
+        Padding of the Gaussian at the sequence ends (docs/method.md decision D3).
     link_normalisation : bool, default=True
         Rescale every link to its mean length over the training frames.
     link_direction : {"original", "simao"}, default="original"
@@ -539,12 +597,15 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
     ----------
     link_lengths_ : ndarray of shape (n_links,)
         Mean training length of every link of the normalisation tree.
-    mean_ : ndarray of shape (n_features_out_,)
+    mean_ : ndarray of shape (n_features_out,)
         Per-feature mean over the training frames.
-    scale_ : ndarray of shape (n_features_out_,)
+    scale_ : ndarray of shape (n_features_out,)
         Per-feature standard deviation (1 where it is below 1e-8).
     n_features_out_ : int
         Width of the descriptor (183 for ``joints="paper11"``).
+    joints_ : DescriptorJoints
+        The joint set the statistics were learned for; ``transform`` refuses
+        a changed ``joints`` until the descriptor is refitted.
     frame_shape_in_ : tuple of int
         Shape of one input frame seen in ``fit``, ``(20, 3)``.
     n_features_in_ : int
@@ -557,10 +618,23 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
 
     Notes
     -----
-    The layout of the 183 features follows METHOD_SPEC §3.13; the triples, body
+    The layout of the 183 features follows docs/method.md §3.13; the triples, body
     frame and degenerate-angle values follow decisions D5-D8. A sequence with no
-    tracked frame gives an all-zero (standardised) descriptor, so every model
-    predicts rest on it; ``fit`` ignores such sequences with a warning.
+    tracked frame gives an all-zero (standardised) descriptor; ``fit`` ignores
+    such sequences with a warning.
+
+    Untracked frames are rest by construction (docs/design.md §1.1):
+    ``transform`` returns a sequence with untracked frames as a
+    ``numpy.ma.MaskedArray`` whose masked rows are those frames (the data under
+    the mask is the descriptor of the filled frames, as before), and every
+    classifier and tagger of skgesture predicts rest on masked rows. A sequence
+    without untracked frames stays a plain ndarray.
+
+    Coordinates must be finite (NaN marks an untracked joint) and at most 1e5
+    in magnitude (metres or millimetres alike); anything else raises a
+    ``ValueError`` naming the sequence and the frame. ``set_output`` is refused:
+    the output is a list of per-sequence arrays, which has no DataFrame form,
+    so a global ``transform_output="pandas"`` setting leaves it unchanged.
 
     References
     ----------
@@ -633,7 +707,11 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         """
         X = self._validate(X, reset=True)
         spec = self._spec()
-        filled, valid_seq = [], []
+        self.joints_ = spec["joints"]
+        links = spec["links"]
+        # Statistics accumulated sequence by sequence (and batch by batch):
+        # fit holds one batch of descriptors at a time, not all of them.
+        bone_sum, n_tracked, valid_seq = 0.0, 0, []
         for i, seq in enumerate(X):
             q, miss = self._prepare(seq)
             if miss.all():
@@ -643,25 +721,29 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
                     stacklevel=2,
                 )
                 continue
-            filled.append(q[~miss])
+            q = q[~miss]
+            bones = _planes(q[:, links[:, 1]] - q[:, links[:, 0]])
+            bone_sum = bone_sum + _norm(bones).sum(axis=-1)
+            n_tracked += len(q)
             valid_seq.append(i)
-        if not filled:
+        if not valid_seq:
             raise ValueError(
                 "every sequence of X is untracked (all-zero or NaN frames)"
             )
-        allq = np.concatenate(filled)
-        links = spec["links"]
-        bones = _planes(allq[:, links[:, 1]] - allq[:, links[:, 0]])
-        self.link_lengths_ = _norm(bones).mean(axis=-1)
+        self.link_lengths_ = bone_sum / n_tracked
         self.n_features_out_ = spec["joints"].n_features
         self.mean_ = np.zeros(self.n_features_out_)
         self.scale_ = np.ones(self.n_features_out_)
         if self.standardize:
-            feats = np.concatenate(
-                self._describe_all([X[i] for i in valid_seq], spec, standardize=False)
+            valid = [X[i] for i in valid_seq]
+            size = BATCH_VALUES // self.n_features_out_
+            chunks = (
+                np.concatenate(
+                    self._describe_all([valid[i] for i in batch], spec, False)
+                )
+                for batch in _batches([len(seq) for seq in valid], size)
             )
-            self.mean_ = feats.mean(axis=0)
-            std = feats.std(axis=0)
+            self.mean_, std = _mean_std(chunks)
             self.scale_ = np.where(std < MIN_SCALE, 1.0, std)
         return self
 
@@ -676,11 +758,43 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         Returns
         -------
         list of ndarray of shape (n_frames_i, n_features_out_)
-            One descriptor matrix per sequence, same number of frames.
+            One descriptor matrix per sequence, same number of frames. A
+            sequence with untracked frames comes as a ``numpy.ma.MaskedArray``
+            whose masked rows are those frames (rest by construction).
         """
         check_is_fitted(self)
+        spec = self._spec()
+        self._check_joints(spec)
         X = self._validate(X, reset=False)
-        return self._describe_all(X, self._spec(), standardize=True)
+        out = self._describe_all(X, spec, standardize=True)
+        for i, seq in enumerate(X):
+            rows = missing_frames(seq)
+            if rows.any():
+                mask = np.repeat(rows[:, None], out[i].shape[1], axis=1)
+                out[i] = np.ma.MaskedArray(out[i], mask=mask)
+        return out
+
+    def set_output(self, *, transform=None):
+        """Refuse a DataFrame output: a list of sequences has none.
+
+        Parameters
+        ----------
+        transform : {"default"} or None, default=None
+            Only ``"default"`` and ``None`` (no change) are accepted.
+
+        Returns
+        -------
+        self : PoseDescriptor
+            Unchanged.
+
+        Raises
+        ------
+        ValueError
+            For ``"pandas"``, ``"polars"`` or any other container. Wrap one
+            sequence's descriptor yourself, e.g.
+            ``pandas.DataFrame(Z[i], columns=desc.get_feature_names_out())``.
+        """
+        return refuse_set_output(self, transform)
 
     def get_feature_names_out(self, input_features=None):
         """Names of the descriptor features, in layout order.
@@ -692,12 +806,14 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
 
         Returns
         -------
-        ndarray of str of shape (n_features_out_,)
+        ndarray of str of shape (n_features_out,)
             Names such as ``"pos_Head_x"``, ``"incl_ShoulderLeft_ElbowLeft_HandLeft"``
             or ``"dist_Head_HandRight"``.
         """
         check_is_fitted(self)
-        dj = self._spec()["joints"]
+        spec = self._spec()
+        self._check_joints(spec)
+        dj = spec["joints"]
         names = []
         for kind in ("pos", "vel", "acc"):
             names += [f"{kind}_{j}_{c}" for j in dj.joints for c in "xyz"]
@@ -710,6 +826,15 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
     # -- internals -------------------------------------------------------------
 
     def _validate(self, X, reset):
+        if isinstance(X, (list, tuple)):
+            # A masked value marks an untracked joint: it becomes NaN, so its
+            # frame is untracked, whatever lies under the mask.
+            X = [
+                np.ma.filled(np.ma.asarray(seq, dtype=float), np.nan)
+                if isinstance(seq, np.ma.MaskedArray)
+                else seq
+                for seq in X
+            ]
         return check_sequences(
             X,
             frame_shape=(KINECT_V1.n_joints, N_COORDS),
@@ -717,7 +842,19 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
             allow_nan=True,
             estimator=self,
             reset=reset,
+            max_abs=MAX_COORDINATE,
         )
+
+    def _check_joints(self, spec):
+        """Refuse a ``joints`` changed since ``fit`` (set_params on a fitted model)."""
+        fitted = getattr(self, "joints_", spec["joints"])
+        if spec["joints"] != fitted:
+            raise ValueError(
+                f"joints was changed after fit: the descriptor was fitted for "
+                f"{fitted.name!r} ({fitted.n_features} features) but joints is now "
+                f"{spec['joints'].name!r} ({spec['joints'].n_features} features); "
+                f"refit the descriptor and every stage after it"
+            )
 
     def _spec(self):
         """Joint, link, triple and pair indices for the chosen joint set.
@@ -768,10 +905,40 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
     def _describe_all(self, X, spec, standardize):
         """Descriptors of sequences ``X``, computed batch by batch."""
         out = []
-        size = BATCH_VALUES // spec["joints"].n_features  # frames per batch
-        for batch in _batches([len(seq) for seq in X], size):
-            out += self._describe_batch([X[i] for i in batch], spec, standardize)
+        kernel = _compiled_kernel()
+        n = spec["joints"].n_features
+        size = (BATCH_VALUES if kernel is None else kernel.BATCH_VALUES) // n
+        lengths = [len(seq) for seq in X]
+        if kernel is not None:  # scratch arrays shared by the batches
+            work = kernel.workspace(spec, n, max(lengths, default=1))
+        for batch in _batches(lengths, size):
+            seqs = [X[i] for i in batch]
+            if kernel is None:
+                out += self._describe_batch(seqs, spec, standardize)
+            else:
+                out += self._describe_compiled(kernel, seqs, spec, standardize, work)
         return out
+
+    def _describe_compiled(self, kernel, X, spec, standardize, work=None):
+        """:meth:`_describe_batch` by the compiled kernel (same descriptors)."""
+        n = spec["joints"].n_features
+        return kernel.describe_batch(
+            X,
+            spec,
+            {
+                "root_u": int(np.searchsorted(spec["used"], _ROOT)),
+                "kernel": gaussian_kernel(self.sigma) if self.sigma > 0 else None,
+                "border": self.border,
+                "link_lengths": self.link_lengths_ if self.link_normalisation else None,
+                "link_direction": self.link_direction,
+                "fill": self.fill,
+                "distance_scale": self.distance_scale,
+            },
+            self.mean_ if standardize else np.zeros(n),
+            self.scale_ if standardize else np.ones(n),
+            0.0 if standardize else self.mean_,
+            work,
+        )
 
     def _describe_batch(self, X, spec, standardize):
         """Descriptors of sequences ``X`` from one pass over their concatenation.
@@ -842,3 +1009,96 @@ class PoseDescriptor(TransformerMixin, BaseEstimator):
         tags.input_tags.allow_nan = True
         tags.requires_fit = True
         return tags
+
+    # -- incremental step (docs/design.md, "Incremental steps") ----------------
+    # The per-frame arithmetic and the state live in skgesture/_incremental.py;
+    # tests/test_streaming.py checks that a stream gives the rows of transform.
+
+    def stream_init(self, *, max_backfill=64, **options):
+        """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Parameters
+        ----------
+        max_backfill : int, default=64
+            Untracked frames at the start of a stream that wait for the first
+            tracked frame and become copies of it, as offline filling does;
+            earlier ones are handed on at once as rest (all-zero masked rows).
+        **options
+            Options of other stages, ignored.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+
+        Examples
+        --------
+        >>> from skgesture import PoseDescriptor
+        >>> from skgesture._incremental import stream_frames
+        >>> from skgesture.utils._testing import make_skeleton_stream
+        >>> X, _ = make_skeleton_stream(random_state=0)
+        >>> desc = PoseDescriptor(fill="hold").fit([X])
+        >>> state = desc.stream_init()
+        >>> rows, state = desc.stream_step(state, stream_frames(X[:10], 0))
+        >>> len(rows), desc.stream_lookahead  # frames 0..5 are final with frame 9
+        (6, 4)
+        >>> last, state = desc.stream_flush(state)
+        >>> bool(abs(rows.data - desc.transform([X[:10]])[0][:6]).max() < 1e-12)
+        True
+        """
+        from skgesture._incremental import DescriptorStream
+
+        check_is_fitted(self)
+        if hasattr(self, "_check_joints"):
+            self._check_joints(self._spec())
+        return DescriptorStream(self, max_backfill=max_backfill)
+
+    def stream_step(self, state, rows):
+        """Raw frames in; the descriptor rows that became final out.
+
+        Every frame is checked as :meth:`transform` checks it, and a bad one
+        raises a ``ValueError`` naming its index in the stream (the state is
+        then unchanged). Untracked frames hold the last tracked frame
+        (``fill="hold"``: the future is unknown) and come out masked.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next raw frames ``(n, 20, 3)``, with their stream indices as
+            ``time``.
+
+        Returns
+        -------
+        out : Rows
+            Descriptor rows ``(m, n_features_out_)``, masked where untracked.
+        state : object
+            The updated state.
+        """
+        from skgesture._incremental import Rows, check_stream_frames
+
+        frames = check_stream_frames(self, rows.data, int(rows.time[0]))
+        return state.step(Rows(frames, rows.mask, rows.time)), state
+
+    def stream_flush(self, state):
+        """End of the stream: the last rows, with the offline end padding.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : Rows
+            The remaining rows.
+        state : object
+            The spent state.
+        """
+        return state.flush(), state
+
+    @property
+    def stream_lookahead(self):
+        """Frames after a frame that its descriptor needs (4; 2 if ``sigma=0``)."""
+        return (GAUSSIAN_SIZE - 1) // 2 * int(self.sigma > 0) + DERIVATIVE_REACH

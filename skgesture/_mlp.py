@@ -12,13 +12,17 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from skgesture._networks import (
+    _ACTIVATIONS,
     SCG_MAX_FAIL,
     TEST_FRACTION,
+    TORCH_RNG_LOCK,
     VALIDATION_FRACTION,
     build_net,
     predict_module,
     seed_from,
+    torch_threads,
 )
+from skgesture.utils._validation import SequenceOf
 
 __all__ = ["TorchMLPClassifier"]
 
@@ -30,7 +34,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
     classes it has one sigmoid output (binary cross-entropy), with more a softmax
     output (cross-entropy). The default solver is MATLAB's full-batch scaled
     conjugate gradient with a random 70/15/15 division, validation stop after 6
-    failures and the best validation weights kept (METHOD_SPEC §8.6).
+    failures and the best validation weights kept (docs/method.md §8.6).
 
     Parameters
     ----------
@@ -57,6 +61,11 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         Validation failures before training stops.
     device : str, default="cpu"
         Torch device, passed to skorch.
+    n_threads : int or None, default=1
+        Torch intra-op CPU threads while fitting and predicting (the previous
+        setting is restored afterwards); ``None`` keeps torch's setting. One
+        thread is fastest for the paper's small networks and never
+        oversubscribes a busy machine or parallel jobs (docs/design.md §6).
     random_state : int, RandomState instance or None, default=None
         Seeds the initialisation, the data division and the shuffling.
     verbose : int, default=0
@@ -90,8 +99,14 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
     """
 
     _parameter_constraints: dict = {
-        "hidden_layer_sizes": [tuple, list],
-        "activations": [tuple, list],
+        "hidden_layer_sizes": [SequenceOf.ints(1, allow_empty=True)],
+        "activations": [
+            SequenceOf(
+                lambda a: isinstance(a, str) and a in _ACTIVATIONS,
+                f"a tuple of names among {sorted(_ACTIVATIONS)}",
+                allow_empty=True,
+            )
+        ],
         "solver": [StrOptions({"scg", "adam", "lbfgs"})],
         "max_epochs": [Interval(Integral, 1, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither"), None],
@@ -100,6 +115,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         "test_fraction": [Interval(Real, 0, 1, closed="left")],
         "max_fail": [Interval(Integral, 1, None, closed="left")],
         "device": [str],
+        "n_threads": [Interval(Integral, 1, None, closed="left"), None],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
@@ -117,6 +133,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         test_fraction=TEST_FRACTION,
         max_fail=SCG_MAX_FAIL,
         device="cpu",
+        n_threads=1,
         random_state=None,
         verbose=0,
     ):
@@ -130,6 +147,7 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         self.test_fraction = test_fraction
         self.max_fail = max_fail
         self.device = device
+        self.n_threads = n_threads
         self.random_state = random_state
         self.verbose = verbose
 
@@ -196,9 +214,15 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         )
         target = y_idx.astype(np.float32).reshape(-1, 1) if binary else y_idx
         # skorch does not seed (its FAQ): the initialisation and the shuffling use
-        # torch's global RNG, so seed it from random_state (STYLE.md §5).
-        torch.manual_seed(seed)
-        self.net_.fit(X, target)
+        # torch's global RNG, so seed it from random_state (docs/design.md §9). Seeding
+        # and initialisation hold a lock: networks fitted in parallel threads
+        # (a Dask worker's, joblib's threading backend) keep their own seeds.
+        # (NeuralNet.fit is initialize + partial_fit.)
+        with torch_threads(self.n_threads):
+            with TORCH_RNG_LOCK:
+                torch.manual_seed(seed)
+                self.net_.initialize()
+            self.net_.partial_fit(X, target)
         return self
 
     def predict_proba(self, X):
@@ -216,10 +240,12 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float32, reset=False)
-        if len(self.classes_) == 2:
-            p = predict_module(self.net_.module_, X, "sigmoid")
-            return np.column_stack([1.0 - p, p])
-        return predict_module(self.net_.module_, X, "softmax")
+        # getattr: a model pickled before n_threads existed keeps torch's setting.
+        with torch_threads(getattr(self, "n_threads", None)):
+            if len(self.classes_) == 2:
+                p = predict_module(self.net_.module_, X, "sigmoid")
+                return np.column_stack([1.0 - p, p])
+            return predict_module(self.net_.module_, X, "softmax")
 
     def predict(self, X):
         """Most probable class.

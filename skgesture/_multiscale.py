@@ -6,38 +6,93 @@ paper's decision rules inside every period of activity (Methods A and B)."""
 from numbers import Integral, Real
 
 import numpy as np
+from sklearn import config_context
 from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
+from tqdm.auto import tqdm
 
 from skgesture._mlp import TorchMLPClassifier
 from skgesture._networks import fit_inner_estimator
-from skgesture._windows import N_POSES, STEPS_A, check_steps, dynamic_poses
+from skgesture._windows import (
+    N_POSES,
+    STEPS_A,
+    DynamicPoses,
+    PeriodWindows,
+    check_lazy_windows,
+    check_steps,
+    dynamic_poses,
+    scale_matrix,
+)
 from skgesture.utils._resize import resize_frames
 from skgesture.utils._segments import labels_to_segments, runs
-from skgesture.utils._validation import check_sequence_labels, check_sequences
+from skgesture.utils._validation import (
+    SequenceOf,
+    check_sequence_labels,
+    check_sequences,
+    untracked_rows,
+)
 
 __all__ = ["MultiScaleClassifier", "decide_period", "period_windows"]
 
-# METHOD_SPEC §5.4
+# docs/method.md §5.4
 WINDOW_HIDDEN = (300, 100)
 WINDOW_ACTIVATIONS = ("tanh", "tanh")
-# METHOD_SPEC §5.2-5.5 (Method A numbers; Method B in the factory)
+# docs/method.md §5.2-5.5 (Method A numbers; Method B in the factory)
 STRIDE = 2
 MIN_WINDOWS = 5
 SHORT_LENGTH = 55
 THRESHOLD_SHORT_A = 0.8717
 THRESHOLD_LONG_A = 0.6255
 MIN_CONSECUTIVE = 3
+# Bounds that keep a resized short period small (docs/design.md §1.2).
+MAX_MIN_WINDOWS = 1000
+MAX_RESIZED_LENGTH = 10_000
+N_LAYOUT_CHECKS = 16  # frames per sequence at which the window steps are checked
 
 
-def _row_mask(x):
-    """Per-row rest mask of a masked sequence, or None for a plain array."""
-    mask = np.ma.getmask(x)
-    if mask is np.ma.nomask:
-        return None if not isinstance(x, np.ma.MaskedArray) else np.zeros(len(x), bool)
-    return mask.reshape(len(x), -1)[:, 0].copy()
+def _is_weight(w):
+    return isinstance(w, Real) and not isinstance(w, bool) and 0 <= w < np.inf
+
+
+WEIGHTS_CONSTRAINT = SequenceOf(
+    _is_weight,
+    "a non-empty tuple of finite weights >= 0, not all 0",
+    whole=lambda w: sum(w) > 0,
+    arrays=True,
+)
+
+
+def _resized_frames(n_frames, n_resized, method):
+    """Position in a period resized to ``n_resized`` frames of each original frame.
+
+    The inverse of the resampling's coordinate map, rounded to the nearest
+    resized frame: ``imresize``'s pixel-centre map for ``"bicubic"``, the
+    end-to-end ``linspace`` map for ``"pchip"`` and ``"spline"``.
+    """
+    t = np.arange(n_frames, dtype=float)
+    if method == "bicubic":
+        u = (t + 0.5) * (n_resized / n_frames) - 0.5
+    elif n_frames > 1:
+        u = t * (n_resized - 1) / (n_frames - 1)
+    else:
+        u = np.full(n_frames, (n_resized - 1) / 2)
+    return np.clip(np.rint(u), 0, n_resized - 1).astype(np.intp)
+
+
+def _map_back(labels, segments, where):
+    """Labels and segments of a resized period on its original frames.
+
+    ``where[t]`` is the resized frame of original frame ``t`` (non-decreasing).
+    """
+    out = labels[where]
+    mapped = []
+    for cls, a, b, conf in segments:
+        lo, hi = np.searchsorted(where, [a, b], side="left")
+        if hi > lo:
+            mapped.append((cls, int(lo), int(hi), conf))
+    return out, mapped
 
 
 def default_window_network():
@@ -61,7 +116,7 @@ def period_windows(
     """Windows of one period ``[start, end)`` at the centres the paper uses.
 
     Centres run from ``start + h`` to ``end - 1 - h`` every ``stride`` frames, with
-    ``h`` the half span of the widest scale (METHOD_SPEC §5.2, §6.2). A period
+    ``h`` the half span of the widest scale (docs/method.md §5.2, §6.2). A period
     with fewer than ``min_windows`` centres is resized along time (cubic, §5.3)
     to the shortest length that has ``min_windows``, and its windows are taken
     there.
@@ -90,15 +145,23 @@ def period_windows(
     """
     h = max(steps) * (n_poses - 1) // 2
     centres = np.arange(start + h, end - h, stride)
+    lazy = isinstance(W, DynamicPoses)  # windows gathered later (scale_matrix)
     if len(centres) >= min_windows:
+        if lazy:
+            return PeriodWindows(W.descriptors, centres, steps, n_poses), centres, False
         return np.asarray(W[centres]), centres, False
     n_features = W.shape[2] // n_poses
     middle = (n_poses - 1) // 2
     # Every row holds its own frame's descriptor as the middle pose.
-    D = np.asarray(W[start:end, 0, middle * n_features : (middle + 1) * n_features])
+    if lazy:
+        D = W.descriptors[start:end]
+    else:
+        D = np.asarray(W[start:end, 0, middle * n_features : (middle + 1) * n_features])
     n_target = 2 * h + 1 + stride * (min_windows - 1)
     D = resize_frames(D.astype(np.float64), n_target, method=resize)
     centres = h + stride * np.arange(min_windows)
+    if lazy:
+        return PeriodWindows(D, centres, steps, n_poses), centres, True
     return dynamic_poses(D, steps, n_poses, centres), centres, True
 
 
@@ -112,8 +175,9 @@ def decide_period(
     threshold_long=THRESHOLD_LONG_A,
     min_consecutive=MIN_CONSECUTIVE,
     half_span=4,
+    original_length=None,
 ):
-    """The paper's decision rule for one period of activity (METHOD_SPEC §5.5).
+    """The paper's decision rule for one period of activity (docs/method.md §5.5).
 
     * Short period (``length < short_length``): every window whose best score
       exceeds ``threshold_short`` votes for its best class; a class with strictly
@@ -142,6 +206,10 @@ def decide_period(
         Shortest run of windows in a long period.
     half_span : int, default=4
         Half the span of a window, in frames.
+    original_length : int or None, default=None
+        For a period resized to ``length`` frames: its original length, which
+        decides between the short and the long rule (``None``: ``length``).
+        Everything else stays in the resized frames.
 
     Returns
     -------
@@ -167,7 +235,7 @@ def decide_period(
         return labels, []
     best = np.argmax(scores, axis=1)
     top = scores[np.arange(len(scores)), best]
-    if length < short_length:
+    if (length if original_length is None else original_length) < short_length:
         votes = best[top > threshold_short]
         if len(votes) == 0:
             return labels, []
@@ -205,6 +273,19 @@ def decide_period(
     return labels, segments
 
 
+def _guess_step(W, D, t, k, j, mid, F):
+    """``"; they look built with step s"`` if one step explains pose ``j`` of
+    scale ``k`` at the frames ``t``, else ``""`` (for an error message)."""
+    if j == mid:
+        return ""
+    T = len(W)
+    pose = W[t, k, j * F : (j + 1) * F]
+    for s in range(1, T):
+        if np.array_equal(pose, D[np.clip(t + (j - mid) * s, 0, T - 1)]):
+            return f"; they look built with step {s} there"
+    return ""
+
+
 class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     """Dynamic-pose classifier at one or more time scales, with the paper's rules.
 
@@ -213,11 +294,19 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     ``weights`` and labels each period of activity with the paper's short/long
     rules. With one scale and the default numbers it is Method A; with
     ``steps=(4, 3, 2)``, ``weights=(0.4895, 0.4576, 0.0529)`` and thresholds
-    0.6014 / 0.6033 it is Method B (METHOD_SPEC §5-6).
+    0.6014 / 0.6033 it is Method B (docs/method.md §5-6).
 
     Periods of activity are the runs of unmasked rows of a masked input (from
     :class:`ActivitySegmenter`); a plain array is one period, so pre-cut clips
-    work without a segmenter.
+    work without a segmenter. Untracked frames are rest by construction: a
+    masked row (from :class:`PoseDescriptor` or the segmenter) and an all-zero
+    row of a plain array are outside every period.
+
+    The windows carry their steps (the middle pose of every scale is the
+    frame's own descriptor), and ``fit`` and ``predict`` check at 16 frames of
+    every sequence that they were built with this classifier's ``steps``, so
+    a window stage whose steps changed (``set_params(windows__steps=...)``)
+    raises instead of giving different labels.
 
     Parameters
     ----------
@@ -227,15 +316,20 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         (tanh) - K (softmax) trained with scaled conjugate gradient.
     steps : tuple of int, default=(4,)
         Time step of each scale; must match the :class:`DynamicPoseWindow`
-        that built the input.
+        that built the input (checked on the data).
     weights : tuple of float or None, default=None
-        Fusion weight of each scale, normalised to sum to 1; equal when None.
+        Fusion weight of each scale, finite and >= 0 (not all 0), normalised to
+        sum to 1; equal when None. A negative weight is refused: it would turn
+        a scale's evidence into evidence against, and the fused score would no
+        longer be a probability the thresholds apply to.
     n_poses : int, default=3
         Descriptors per dynamic pose.
     stride : int, default=2
         Frames between window centres.
     min_windows : int, default=5
-        Periods with fewer windows are resized along time first.
+        Periods with fewer windows are resized along time first (at most
+        1000; the resized length ``2 h + 1 + stride * (min_windows - 1)``,
+        with ``h`` the half span of the widest scale, at most 10,000 frames).
     short_length : int, default=55
         Periods shorter than this get a single label by majority vote.
     threshold_short : float, default=0.8717
@@ -253,7 +347,8 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     random_state : int, RandomState instance or None, default=None
         Seeds the networks (overrides the estimator's own ``random_state``).
     verbose : int, default=0
-        Verbosity.
+        0 is silent; 1 shows a progress bar over the scales and the network's
+        bar over its epochs; 2 prints one line per epoch of every network.
 
     Attributes
     ----------
@@ -288,11 +383,11 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
 
     _parameter_constraints: dict = {
         "estimator": [HasMethods(["fit", "predict_proba"]), None],
-        "steps": [tuple, list],
-        "weights": [tuple, list, np.ndarray, None],
+        "steps": [SequenceOf.ints(1)],
+        "weights": [WEIGHTS_CONSTRAINT, None],
         "n_poses": [Interval(Integral, 1, None, closed="left")],
         "stride": [Interval(Integral, 1, None, closed="left")],
-        "min_windows": [Interval(Integral, 1, None, closed="left")],
+        "min_windows": [Interval(Integral, 1, MAX_MIN_WINDOWS, closed="both")],
         "short_length": [Interval(Integral, 1, None, closed="left")],
         "threshold_short": [Interval(Real, 0, 1, closed="both")],
         "threshold_long": [Interval(Real, 0, 1, closed="both")],
@@ -354,8 +449,9 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             The fitted classifier.
         """
         steps = self._check_steps()
-        X = check_sequences(X, ndim=3, estimator=self, reset=True, dtype=np.float32)
-        self._check_layout(X[0], steps)
+        if not check_lazy_windows(X, steps, self.n_poses, self, reset=True):
+            X = check_sequences(X, ndim=3, estimator=self, reset=True, dtype=np.float32)
+            self._check_layout(X, steps)
         y = check_sequence_labels(y, X)
         wins, labels = [], []
         for W, lab in zip(X, y):
@@ -368,7 +464,6 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
                 "y has no gesture instance (every label is 0): nothing to train "
                 "the window classifier on"
             )
-        wins = np.concatenate(wins)
         labels = np.concatenate(labels)
         self.classes_ = np.unique(labels)
         if len(self.classes_) < 2:
@@ -384,9 +479,20 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         default = default_window_network()
         self.estimators_ = [
             fit_inner_estimator(
-                self.estimator, default, wins[:, k], labels, rng=rng, memory=self.memory
+                self.estimator,
+                default,
+                scale_matrix(wins, k),  # one scale's windows at a time
+                labels,
+                rng=rng,
+                memory=self.memory,
+                verbose=self.verbose,
             )
-            for k in range(len(steps))
+            for k in tqdm(
+                range(len(steps)),
+                desc=f"{type(self).__name__}: networks of steps {steps}",
+                unit="scale",
+                disable=self.verbose < 1,
+            )
         ]
         return self
 
@@ -444,6 +550,7 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     # -- internals -------------------------------------------------------------
 
     def _check_steps(self):
+        """Parameters that constrain each other (also checked by ``predict``)."""
         steps = check_steps(self.steps, self.n_poses)
         if self.weights is not None:
             w = np.asarray(self.weights, dtype=float)
@@ -451,10 +558,20 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
                 raise ValueError(
                     f"weights has {w.size} values but steps has {len(steps)} scales"
                 )
-            if np.any(w < 0) or w.sum() <= 0:
+            if not (np.all(np.isfinite(w)) and np.all(w >= 0) and w.sum() > 0):
                 raise ValueError(
-                    f"weights must be non-negative and not all 0, got {self.weights}"
+                    f"weights must be finite, non-negative and not all 0, got "
+                    f"{self.weights}"
                 )
+        h = max(steps) * (self.n_poses - 1) // 2
+        n_resized = 2 * h + 1 + self.stride * (self.min_windows - 1)
+        if n_resized > MAX_RESIZED_LENGTH:
+            raise ValueError(
+                f"steps={steps}, n_poses={self.n_poses}, stride={self.stride} and "
+                f"min_windows={self.min_windows} would resize every short period "
+                f"to {n_resized} frames (2 * {h} + 1 + stride * (min_windows - 1)); "
+                f"at most {MAX_RESIZED_LENGTH} are allowed"
+            )
         return steps
 
     def _fusion_weights(self, n_scales):
@@ -463,32 +580,44 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         w = np.asarray(self.weights, dtype=float)
         return w / w.sum()
 
-    def _check_layout(self, W, steps):
-        """The input must come from windows with this classifier's steps."""
-        if W.shape[1] != len(steps):
+    def _check_layout(self, X, steps):
+        """The windows must be dynamic poses built with this classifier's steps.
+
+        Pose ``j`` of scale ``k`` at frame ``t`` must be the descriptor of frame
+        ``clip(t + (j - middle) * steps[k])``, i.e. the middle pose of the first
+        scale at that frame. Checked exactly (both are float32 copies of one
+        descriptor) at ``N_LAYOUT_CHECKS`` frames spread over every sequence.
+        """
+        n_scales, width = X[0].shape[1:]
+        if n_scales != len(steps):
             raise ValueError(
-                f"X has {W.shape[1]} scales per frame but steps={tuple(steps)} has "
+                f"X has {n_scales} scales per frame but steps={tuple(steps)} has "
                 f"{len(steps)}: build X with DynamicPoseWindow(steps={tuple(steps)})"
             )
-        F = W.shape[2] // self.n_poses
-        if W.shape[2] != F * self.n_poses:
+        F = width // self.n_poses
+        if width != F * self.n_poses:
             raise ValueError(
-                f"window width {W.shape[2]} is not a multiple of n_poses={self.n_poses}"
+                f"window width {width} is not a multiple of n_poses={self.n_poses}"
             )
-        T = len(W)
         mid = (self.n_poses - 1) // 2
-        for k, s in enumerate(steps):
-            t = min(max(steps), T - 1)
-            if t - s < 0 or T <= max(steps) * 2:
-                continue
-            first = np.asarray(W[t, k, :F])
-            expect = np.asarray(W[t - s * mid, 0, mid * F : (mid + 1) * F])
-            if not np.allclose(first, expect, atol=1e-6):
-                raise ValueError(
-                    f"X does not look like dynamic poses with steps={tuple(steps)} "
-                    f"(scale {k}): use the same steps in DynamicPoseWindow and "
-                    f"MultiScaleClassifier"
-                )
+        for i, W in enumerate(X):
+            T = len(W)
+            t = np.unique(np.linspace(0, T - 1, min(T, N_LAYOUT_CHECKS)).astype(int))
+            D = W[:, 0, mid * F : (mid + 1) * F]  # every frame's own descriptor
+            for k, s in enumerate(steps):
+                for j in range(self.n_poses):
+                    pose = W[t, k, j * F : (j + 1) * F]
+                    src = np.clip(t + (j - mid) * s, 0, T - 1)
+                    if np.array_equal(pose, D[src]):
+                        continue
+                    bad = int(t[np.flatnonzero((pose != D[src]).any(axis=1))[0]])
+                    raise ValueError(
+                        f"X[{i}] does not hold dynamic poses with steps="
+                        f"{tuple(steps)}: scale {k} disagrees at frame {bad}"
+                        f"{_guess_step(W, D, t, k, j, mid, F)}. The window stage "
+                        f"and the classifier must use the same steps, e.g. "
+                        f"pipe.set_params(windows__steps=s, classifier__steps=s)"
+                    )
 
     def _windows(self, W, s, e, steps):
         return period_windows(
@@ -505,50 +634,53 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
     def _decide(self, X):
         check_is_fitted(self)
         steps = self._check_steps()
-        # A row is rest when it is masked (the first value of a row decides).
-        masks = [_row_mask(x) for x in X]
-        X = check_sequences(X, ndim=3, estimator=self, reset=False, dtype=np.float32)
+        if check_lazy_windows(X, steps, self.n_poses, self, reset=False):
+            masks = [W.rest_rows() for W in X]  # as untracked_rows of the dense
+        else:
+            data = check_sequences(
+                X, ndim=3, estimator=self, reset=False, dtype=np.float32
+            )
+            self._check_layout(data, steps)
+            # A row is rest when it is masked or untracked (all zeros).
+            masks = [
+                untracked_rows(x if isinstance(x, np.ma.MaskedArray) else W)
+                for x, W in zip(X, data)
+            ]
+            X = data
         # Gather the windows of every period of every sequence, score them in
         # one call per scale, then apply the decision rules period by period.
         periods, wins = [], []
         for i, (W, rest) in enumerate(zip(X, masks)):
-            if rest is None:
-                bounds = [(0, len(W))]
-            else:
-                starts, ends, vals = runs(rest)
-                bounds = [(s, e) for s, e, v in zip(starts, ends, vals) if not v]
+            starts, ends, vals = runs(rest)
+            bounds = [(s, e) for s, e, v in zip(starts, ends, vals) if not v]
             for s, e in bounds:
                 w, centres, resized = self._windows(W, s, e, steps)
-                periods.append((i, s, e, centres - (0 if resized else s), len(w)))
+                # A resized period's centres are in its resized frames (§5.3).
+                periods.append(
+                    (i, s, e, centres - (0 if resized else s), len(w), resized)
+                )
                 wins.append(w)
         scores = np.zeros((0, len(self.classes_)))
         if wins:
-            allw = np.concatenate(wins)
             fused = self._fusion_weights(len(steps))
-            scores = sum(
-                wk * est.predict_proba(allw[:, k])
-                for k, (wk, est) in enumerate(zip(fused, self.estimators_))
-            )
-        half = max(steps) * (self.n_poses - 1) // 2
+            # The windows hold validated (finite) descriptors: the networks
+            # need not scan them again.
+            with config_context(assume_finite=True):
+                scores = sum(
+                    wk * est.predict_proba(scale_matrix(wins, k))
+                    for k, (wk, est) in enumerate(zip(fused, self.estimators_))
+                )
         out = [(np.zeros(len(W), dtype=np.int64), []) for W in X]
         pos = 0
-        for i, s, e, centres, n in periods:
-            lab, segs = decide_period(
-                scores[pos : pos + n],
-                centres,
-                e - s,
-                short_length=self.short_length,
-                threshold_short=self.threshold_short,
-                threshold_long=self.threshold_long,
-                min_consecutive=self.min_consecutive,
-                half_span=half,
-            )
+        for i, s, e, centres, n, resized in periods:
+            segs = self._period_segments(scores[pos : pos + n], centres, e - s, resized)
             pos += n
-            nz = lab > 0
-            out[i][0][s:e][nz] = self.classes_[lab[nz] - 1]
-            out[i][1].extend(
-                (self.classes_[c - 1], s + a, s + b, conf) for c, a, b, conf in segs
-            )
+            # The labels of a period are its segments (decide_period reads the
+            # segments off its labels, which are rest elsewhere).
+            for c, a, b, conf in segs:
+                label = self.classes_[c - 1]
+                out[i][0][s + a : s + b] = label
+                out[i][1].append((label, s + a, s + b, conf))
         return [(lab, np.array(segs, dtype=float).reshape(-1, 4)) for lab, segs in out]
 
     def __sklearn_tags__(self):
@@ -556,3 +688,116 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
         tags.input_tags.two_d_array = False
         tags.input_tags.three_d_array = True
         return tags
+
+    # -- incremental step (docs/design.md, "Incremental steps") ----------------
+    # The state (skgesture/_incremental.py, MultiScaleStream) tracks periods,
+    # scores windows as they complete and decides each period with
+    # _period_segments, the decision of one period that _decide uses too.
+
+    def _period_segments(self, scores, centres, length, resized, short_length=None):
+        """Segments of one period: the paper's rules, as :meth:`predict` applies
+        them (a resized period is decided on its resized frames and mapped
+        back). ``short_length`` overrides the parameter (0: the long rule)."""
+        steps = check_steps(self.steps, self.n_poses)
+        half = max(steps) * (self.n_poses - 1) // 2
+        n_resized = (
+            2 * int(centres[0]) + 1 + self.stride * (len(centres) - 1)
+            if resized
+            else None
+        )
+        lab, segs = decide_period(
+            scores,
+            centres,
+            length if n_resized is None else n_resized,
+            short_length=self.short_length if short_length is None else short_length,
+            threshold_short=self.threshold_short,
+            threshold_long=self.threshold_long,
+            min_consecutive=self.min_consecutive,
+            half_span=half,
+            original_length=length,
+        )
+        if n_resized is not None:  # back from the resized frames (§5.3)
+            where = _resized_frames(length, n_resized, self.resize)
+            lab, segs = _map_back(lab, segs, where)
+        return segs
+
+    def stream_init(self, *, max_period=1200, early_decision=False, **options):
+        """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Parameters
+        ----------
+        max_period : int, default=1200
+            A period this long (in frames) is closed and decided, and activity
+            that continues opens a new one: it bounds memory and delay on a
+            stream that never rests (offline ``predict`` has no cap).
+        early_decision : bool, default=False
+            Treat every period as long from its start: runs of windows are
+            emitted without waiting ``short_length`` frames, and a period that
+            ends short gets its majority vote only if nothing was emitted in
+            it. Less delay, but the events may differ from ``predict``.
+        **options
+            Options of other stages, ignored.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+        """
+        from skgesture._incremental import MultiScaleStream
+
+        check_is_fitted(self)
+        return MultiScaleStream(
+            self, max_period=max_period, early_decision=early_decision
+        )
+
+    def stream_step(self, state, rows):
+        """Descriptor rows (masked at rest) in; the gestures decided out.
+
+        Periods are the runs of unmasked rows. The window centred at ``c`` is
+        built and scored once frame ``c + hw`` is known to be in the period; a
+        period is decided with the rules of :meth:`predict` when it ends, and
+        in a period known to be long a run of windows is emitted as soon as
+        no later window can change it (docs/streaming.md, "Delay").
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next rows of a :class:`DynamicPoseWindow` stream step.
+
+        Returns
+        -------
+        out : list of StreamSegment
+            ``(label, start, end, confidence, time)`` of each gesture decided.
+        state : object
+            The updated state.
+        """
+        return state.step(rows), state
+
+    def stream_flush(self, state):
+        """End of the stream: decide the open period.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : list of StreamSegment
+            The remaining gestures.
+        state : object
+            The spent state.
+        """
+        return state.flush(), state
+
+    @property
+    def stream_lookahead(self):
+        """Frames between a gesture's last frame and its decision, at most.
+
+        Once the period is known to be long: ``2 hw + stride`` (10), ``hw`` the
+        half span of the widest window (docs/streaming.md, "Delay").
+        """
+        steps = check_steps(self.steps, self.n_poses)
+        return max(steps) * (self.n_poses - 1) + self.stride

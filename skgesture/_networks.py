@@ -1,43 +1,53 @@
 """Torch modules and the skorch wiring shared by every network in skgesture.
 
-:func:`build_net` makes the skorch net of any of the paper's MLPs. Estimators that
+:func:`build_net` makes the skorch net of any of the paper's MLPs;
+:class:`FramewiseNetwork` holds the one training loop of every framewise tagger
+network (Method C's BiLSTM and the recommended taggers). Estimators that
 own networks fit them through :func:`fit_cached`, which caches the fitted network
 with ``joblib.Memory`` keyed on the training data and the network's own
 parameters only, so decision parameters (thresholds, weights, smoothing,
-minimum lengths) can be searched by ``GridSearchCV`` without retraining (DESIGN.md §3).
+minimum lengths) can be searched by ``GridSearchCV`` without retraining
+(docs/design.md §3).
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
 import copy
+import threading
 from contextlib import contextmanager
 
 import numpy as np
 import torch
-from sklearn.base import clone
+from sklearn.base import BaseEstimator, clone
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_memory
 from skorch import NeuralNet
-from skorch.callbacks import Callback, EpochTimer, PrintLog
+from skorch.callbacks import Callback, EarlyStopping
 from skorch.dataset import Dataset
 from torch import nn
+from torch.nn import functional as F
 
 __all__ = [
+    "FramewiseLoss",
+    "FramewiseNetwork",
     "MLPModule",
     "build_net",
     "fit_cached",
+    "held_out_sequences",
     "predict_module",
     "seed_from",
     "torch_threads",
 ]
 
-# MATLAB trainscg defaults, METHOD_SPEC §8.6.1
+# MATLAB trainscg defaults, docs/method.md §8.6.1
 SCG_MAX_FAIL = 6
 SCG_MIN_GRAD = 1e-6
-# MATLAB dividerand defaults, METHOD_SPEC §8.6.4
+# MATLAB dividerand defaults, docs/method.md §8.6.4
 VALIDATION_FRACTION = 0.15
 TEST_FRACTION = 0.15
 PREDICT_BATCH = 65536
+IGNORE_INDEX = -100  # target of frames a framewise loss leaves out (padding, untracked)
+SMOOTHING_CLAMP = 16.0  # MS-TCN's truncation of the squared log-prob change
 
 _ACTIVATIONS = {
     "relu": nn.ReLU,
@@ -80,6 +90,20 @@ class MLPModule(nn.Module):
 
     def forward(self, X):
         return self.net(X)
+
+
+class MatlabCrossEntropy(nn.CrossEntropyLoss):
+    """MATLAB's ``crossentropy`` of a softmax output (docs/method.md §8.6.5).
+
+    ``-t log y`` averaged over samples *and* outputs: torch's cross-entropy
+    averaged over the samples, divided by the number of outputs ``K``. The
+    scale matters to SCG: on a loss ``K`` times larger, its initial ``lambda``
+    and its ``min_grad`` stop act as if ``K`` times smaller (docs/method.md
+    §8.6.5).
+    """
+
+    def forward(self, input, target):
+        return super().forward(input, target) / input.shape[-1]
 
 
 class _MatlabDivision:
@@ -164,11 +188,14 @@ class _TrainOnly:
 class _MatlabStopping(Callback):
     """Validation stop and best-weights restore as MATLAB's trainers do (§8.6.3-4).
 
-    After each epoch, a validation loss below the best so far stores the weights
-    and resets the failure count; a higher one counts a failure; an equal one
-    changes nothing. Training stops after ``max_fail`` failures, or when the SCG
-    gradient norm falls below ``min_grad``; the best weights are restored at the
-    end. Without validation data the lowest training loss decides.
+    The best so far starts as the initial weights and their loss (MATLAB's
+    ``validation_start``), measured before the first epoch. After each epoch, a
+    validation loss below the best so far stores the weights and resets the
+    failure count; a higher one counts a failure; an equal one changes nothing.
+    Training stops after ``max_fail`` failures, or when the SCG gradient norm
+    falls below ``min_grad``; the best weights are restored at the end, the
+    initial ones if no epoch beat them. Without validation data the lowest
+    training loss decides.
     """
 
     def __init__(self, max_fail=SCG_MAX_FAIL, min_grad=SCG_MIN_GRAD):
@@ -176,10 +203,17 @@ class _MatlabStopping(Callback):
         self.min_grad = min_grad
 
     def on_train_begin(self, net, **kwargs):
-        self.best_loss_ = np.inf
+        self.best_loss_ = None  # set from the initial weights at the first epoch
         self.best_state_ = None
         self.best_epoch_ = 0
         self.fails_ = 0
+
+    def on_epoch_begin(self, net, dataset_train=None, dataset_valid=None, **kwargs):
+        if self.best_loss_ is not None:
+            return
+        dataset = dataset_valid if dataset_valid is not None else dataset_train
+        self.best_loss_ = np.inf if dataset is None else _mean_loss(net, dataset)
+        self.best_state_ = copy.deepcopy(net.module_.state_dict())
 
     def on_epoch_end(self, net, **kwargs):
         row = net.history[-1]
@@ -209,6 +243,18 @@ class _MatlabStopping(Callback):
             net.best_epoch_ = self.best_epoch_
 
 
+def _mean_loss(net, dataset):
+    """Loss of the current weights on ``dataset``, averaged as skorch records it
+    (batch losses weighted by batch size), without a gradient."""
+    total, count = 0.0, 0
+    for batch in net.get_iterator(dataset, training=False):
+        step = net.validation_step(batch)
+        n = len(batch[0])
+        total += float(step["loss"]) * n
+        count += n
+    return total / count if count else np.inf
+
+
 class EpochProgress(Callback):
     """A tqdm bar over epochs showing the latest losses (``verbose=1``)."""
 
@@ -230,6 +276,179 @@ class EpochProgress(Callback):
 
     def on_train_end(self, net, **kwargs):
         self.bar_.close()
+
+
+# -- the training loop of every framewise tagger network -------------------------
+
+
+class FramewiseLoss(nn.Module):
+    """Cross-entropy of every frame of ``(batch, time, classes)`` logits.
+
+    The loss of every tagger network. Frames whose target is ``IGNORE_INDEX``
+    (padding, untracked frames) are left out. A tuple of logits (the stages
+    of an MS-TCN) adds up the loss of every stage.
+
+    Parameters
+    ----------
+    time_reduction : {"mean", "sum"}, default="mean"
+        ``"mean"`` averages over every frame of the batch (weighted by
+        ``class_weight``); ``"sum"`` sums over the frames of each sequence and
+        averages over the sequences (MATLAB's sequence loss, docs/method.md
+        §7.2).
+    class_weight : list of float or None, default=None
+        Weight of each class in the cross-entropy.
+    smoothing_weight : float, default=0.0
+        Weight of MS-TCN's smoothing loss, the truncated mean squared change of
+        the log-probabilities between consecutive frames (Farha & Gall 2019);
+        0 disables it.
+    """
+
+    def __init__(self, time_reduction="mean", class_weight=None, smoothing_weight=0.0):
+        super().__init__()
+        self.time_reduction = time_reduction
+        weight = None if class_weight is None else torch.as_tensor(class_weight)
+        self.register_buffer("weight", weight)
+        self.smoothing_weight = smoothing_weight
+
+    def forward(self, output, target):
+        stages = output if isinstance(output, (tuple, list)) else (output,)
+        loss = None
+        for logits in stages:
+            term = self._cross_entropy(logits, target)
+            loss = term if loss is None else loss + term
+            if self.smoothing_weight:
+                logp = F.log_softmax(logits, dim=-1)
+                change = (logp[:, 1:] - logp[:, :-1].detach()) ** 2
+                valid = (target[:, 1:] != IGNORE_INDEX) & (
+                    target[:, :-1] != IGNORE_INDEX
+                )
+                if valid.any():
+                    change = torch.clamp(change, max=SMOOTHING_CLAMP)[valid]
+                    loss = loss + self.smoothing_weight * change.mean()
+        return loss
+
+    def _cross_entropy(self, logits, target):
+        flat, flat_target = logits.reshape(-1, logits.shape[-1]), target.reshape(-1)
+        if self.time_reduction == "sum":
+            total = F.cross_entropy(
+                flat,
+                flat_target,
+                weight=self.weight,
+                ignore_index=IGNORE_INDEX,
+                reduction="sum",
+            )
+            return total / target.shape[0]
+        if not (flat_target != IGNORE_INDEX).any():
+            # Every frame ignored (e.g. a held-out sequence that never tracked):
+            # no evidence, a zero loss rather than torch's 0/0 = NaN.
+            return flat.sum() * 0.0
+        return F.cross_entropy(
+            flat, flat_target, weight=self.weight, ignore_index=IGNORE_INDEX
+        )
+
+
+def held_out_sequences(n_sequences, fraction, seed):
+    """Indices of the whole sequences held out for validation.
+
+    ``round(fraction * n_sequences)`` of them, at least 1 and at most
+    ``n_sequences - 1``, drawn by ``numpy.random.RandomState(seed)``.
+
+    Examples
+    --------
+    >>> from skgesture._networks import held_out_sequences
+    >>> len(held_out_sequences(10, 0.2, seed=0))
+    2
+    """
+    n_valid = min(max(int(round(fraction * n_sequences)), 1), n_sequences - 1)
+    return np.random.RandomState(seed).choice(n_sequences, n_valid, replace=False)
+
+
+def _silent(*args, **kwargs):
+    """A skorch ``sink`` that prints nothing."""
+
+
+class FramewiseNetwork(BaseEstimator):
+    """The trainable part of a tagger, with the training loop every tagger shares.
+
+    A subclass is fitted through :func:`fit_cached` (its parameters are the
+    network and training parameters only, so a tagger's decoding parameters
+    never change the cache key). Its ``fit`` prepares what differs between
+    taggers: the sampler of the training data (a dataset, its iterators and a
+    ``train_split`` holding out whole sequences), the module, the optimiser
+    and the schedule; :meth:`_train` does the rest, the same way for every
+    tagger: the loss (:class:`FramewiseLoss`), early stopping on the held-out
+    sequences (best epoch restored), progress (``verbose``), the device, and
+    seeding under ``TORCH_RNG_LOCK``.
+
+    A subclass has the parameters ``max_epochs``, ``batch_size``,
+    ``learning_rate``, ``early_stopping``, ``n_iter_no_change``, ``device``
+    and ``verbose``.
+    """
+
+    # verbose >= this prints one line per epoch (skorch's log); 1 .. this - 1
+    # shows a tqdm bar over epochs
+    _epoch_lines_from = 2
+
+    def _train(
+        self,
+        module,
+        data,
+        target=None,
+        *,
+        seed,
+        n_sequences,
+        train_split,
+        callbacks=(),
+        module_params=None,
+        criterion_params=None,
+        **net_params,
+    ):
+        """Build the skorch ``NeuralNet`` and fit it on ``(data, target)``.
+
+        ``train_split`` is used with ``early_stopping`` only; ``callbacks``
+        (the schedule) come before the early stopping and the progress bar;
+        ``net_params`` are further ``NeuralNet`` arguments (the optimiser, the
+        iterators of the sampler). Returns the fitted net.
+        """
+        if self.early_stopping and n_sequences < 2:
+            raise ValueError(
+                "early_stopping holds out whole sequences for validation and "
+                f"needs at least 2 training sequences, got {n_sequences}"
+            )
+        lines = self.verbose >= self._epoch_lines_from
+        callbacks = list(callbacks)
+        if self.early_stopping:
+            stopper = EarlyStopping(
+                monitor="valid_loss",
+                patience=self.n_iter_no_change,
+                load_best=True,
+                sink=print if lines else _silent,
+            )
+            callbacks.append(("early_stopping", stopper))
+        if self.verbose and not lines:
+            callbacks.append(("progress", EpochProgress()))
+        net = NeuralNet(
+            module,
+            **{f"module__{k}": v for k, v in (module_params or {}).items()},
+            criterion=FramewiseLoss,
+            **{f"criterion__{k}": v for k, v in (criterion_params or {}).items()},
+            lr=self.learning_rate,
+            max_epochs=self.max_epochs,
+            batch_size=self.batch_size,
+            train_split=train_split if self.early_stopping else None,
+            callbacks=callbacks,
+            device=self.device,
+            verbose=int(lines),
+            **net_params,
+        )
+        # Initialisation, dropout and shuffling draw from torch's global RNG:
+        # seeded in a fork, under the lock, so that neither the caller's RNG
+        # nor a network fitted in a parallel thread interferes.
+        on_gpu = str(self.device).startswith("cuda")
+        with TORCH_RNG_LOCK, torch.random.fork_rng(devices=None if on_gpu else []):
+            torch.manual_seed(seed)
+            net.fit(data, target)
+        return net
 
 
 def _solver_settings(solver, learning_rate, batch_size, n_samples):
@@ -271,11 +490,12 @@ def build_net(
     """An unfitted skorch ``NeuralNet`` around :class:`MLPModule`.
 
     ``loss="binary"`` uses a sigmoid output with binary cross-entropy,
-    ``"multiclass"`` a softmax output with cross-entropy (MATLAB ``crossentropy``,
-    METHOD_SPEC §8.6.5). Training stops as MATLAB's trainers do
-    (:class:`_MatlabStopping`) on a random 70/15/15 division.
+    ``"multiclass"`` a softmax output with cross-entropy averaged over samples and
+    outputs (:class:`MatlabCrossEntropy`, MATLAB ``crossentropy``, docs/method.md
+    §8.6.5). Training stops as MATLAB's trainers do (:class:`_MatlabStopping`) on
+    a random 70/15/15 division.
     """
-    criterion = nn.BCEWithLogitsLoss if loss == "binary" else nn.CrossEntropyLoss
+    criterion = nn.BCEWithLogitsLoss if loss == "binary" else MatlabCrossEntropy
     optimizer, opt_kwargs, batch = _solver_settings(
         solver, learning_rate, batch_size, n_samples
     )
@@ -286,8 +506,8 @@ def build_net(
     callbacks = [("matlab_stop", _MatlabStopping(max_fail=max_fail))]
     if verbose == 1:
         callbacks.append(("progress", EpochProgress()))
-    elif verbose > 1:
-        callbacks += [("epoch_timer", EpochTimer()), ("print_log", PrintLog())]
+    # verbose >= 2: skorch's own default callbacks (epoch timer, print log) print
+    # one line per epoch once the net is verbose.
     return NeuralNet(
         MLPModule,
         criterion=criterion,
@@ -300,10 +520,18 @@ def build_net(
         iterator_train__shuffle=solver == "adam",
         callbacks=callbacks,
         device=device,
-        verbose=0,
+        verbose=int(verbose > 1),
         **{f"module__{k}": v for k, v in module_params.items()},
         **{f"optimizer__{k}": v for k, v in opt_kwargs.items()},
     )
+
+
+# Held while seeding torch's global RNG and initialising a network from it, so
+# that networks fitted in parallel threads (joblib's threading backend, a Dask
+# worker with threads) each get the initial weights of their own seed. A tagger
+# network (FramewiseNetwork._train) holds it for its whole fit: its dropout and
+# window shuffling draw from that RNG at every epoch.
+TORCH_RNG_LOCK = threading.RLock()
 
 
 @contextmanager
@@ -325,8 +553,11 @@ def torch_threads(n_threads):
         torch.set_num_threads(before)
 
 
-def _fit_clone(estimator, X, y):
-    return clone(estimator).fit(X, y)
+def _fit_clone(estimator, X, y, verbose=None):
+    est = clone(estimator)
+    if verbose is not None:
+        est.set_params(verbose=verbose)
+    return est.fit(X, y)
 
 
 def fit_cached(memory, estimator, X, y):
@@ -334,7 +565,8 @@ def fit_cached(memory, estimator, X, y):
 
     The cache key is the estimator's parameters and the data, nothing else: an
     estimator holding this network sees the same cached network whatever its own
-    decision parameters are (DESIGN.md §3).
+    decision parameters are (docs/design.md §3). Its ``verbose`` is left out of the
+    key too: showing progress never retrains a cached network.
 
     Parameters
     ----------
@@ -352,7 +584,14 @@ def fit_cached(memory, estimator, X, y):
         The fitted clone.
     """
     memory = check_memory(memory)
-    return memory.cache(_fit_clone)(estimator, X, y)
+    verbose = None
+    if "verbose" in estimator.get_params(deep=False):
+        verbose = estimator.get_params(deep=False)["verbose"]
+        estimator = clone(estimator).set_params(verbose=0)
+    fitted = memory.cache(_fit_clone, ignore=["verbose"])(estimator, X, y, verbose)
+    if verbose is not None:
+        fitted.set_params(verbose=verbose)  # as asked, even from the cache
+    return fitted
 
 
 def predict_module(module, X, output):
@@ -393,18 +632,23 @@ def predict_module(module, X, output):
 
 
 def seed_from(random_state):
-    """An int seed for torch drawn from a numpy ``random_state`` (STYLE.md §5)."""
+    """An int seed for torch drawn from a numpy ``random_state`` (docs/design.md §9)."""
     return int(check_random_state(random_state).randint(np.iinfo(np.int32).max))
 
 
-def fit_inner_estimator(estimator, default, X, y, *, rng, memory):
+def fit_inner_estimator(estimator, default, X, y, *, rng, memory, verbose=0):
     """Fit a clone of ``estimator`` (or of ``default``) for a sequence estimator.
 
     When ``rng`` is given, an int seed drawn from it replaces the clone's
     ``random_state`` (if it has one), so one ``random_state`` on the outer
-    estimator controls every network it trains.
+    estimator controls every network it trains. A ``verbose`` above 0 is handed
+    on to the clone (if it has that parameter), so the outer estimator's
+    verbosity shows the network's progress: a bar at 1, one line per epoch at 2.
     """
     est = clone(default if estimator is None else estimator)
-    if rng is not None and "random_state" in est.get_params():
+    params = est.get_params()
+    if rng is not None and "random_state" in params:
         est.set_params(random_state=seed_from(rng))
+    if verbose and "verbose" in params:
+        est.set_params(verbose=verbose)
     return fit_cached(memory, est, X, y)

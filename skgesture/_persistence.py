@@ -73,8 +73,11 @@ _SKORCH_ATTRIBUTES = {
 _TRAINING_ONLY = {"callbacks", "train_split"}
 # skgesture modules whose estimator classes are trusted by load_model.
 _TRUSTED_MODULES = (
+    "skgesture._augment",
     "skgesture._bilstm",
     "skgesture._descriptor",
+    "skgesture._features",
+    "skgesture._modules",
     "skgesture._mlp",
     "skgesture._multiscale",
     "skgesture._segmenter",

@@ -8,17 +8,22 @@ import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import HasMethods, Interval
-from sklearn.utils.validation import check_is_fitted
+from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
 from skgesture._mlp import TorchMLPClassifier
 from skgesture._networks import fit_inner_estimator
 from skgesture.utils._segments import remove_short_runs, runs
 from skgesture.utils._smoothing import loess_smooth
-from skgesture.utils._validation import check_sequence_labels, check_sequences
+from skgesture.utils._validation import (
+    check_sequence_labels,
+    check_sequences,
+    refuse_set_output,
+    untracked_rows,
+)
 
 __all__ = ["ActivitySegmenter"]
 
-# METHOD_SPEC §4
+# docs/method.md §4
 SEGMENTER_HIDDEN = (100, 100)
 SEGMENTER_ACTIVATIONS = ("relu", "tanh")
 N_CONTEXT = 10  # rest frames before and after each gesture (decision D13)
@@ -35,7 +40,7 @@ def default_frame_network():
 
 
 def context_mask(y, n_context):
-    """Training frames of the segmenter in one sequence (METHOD_SPEC §4.1).
+    """Training frames of the segmenter in one sequence (docs/method.md §4.1).
 
     Every gesture frame, plus up to ``n_context`` rest frames right before and
     right after each gesture (all rest frames when ``n_context`` is None).
@@ -71,12 +76,14 @@ def context_mask(y, n_context):
     return keep
 
 
-class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
+class ActivitySegmenter(
+    ClassifierMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+):
     """Framewise gesture-vs-rest detector giving the periods of activity.
 
     A network scores every frame's descriptor; the score track is smoothed with
     MATLAB-style loess, thresholded, and runs of active frames shorter than
-    ``min_length`` are dropped (METHOD_SPEC §4). ``predict`` gives per-frame 0/1;
+    ``min_length`` are dropped (docs/method.md §4). ``predict`` gives per-frame 0/1;
     ``transform`` hands the features on as masked arrays whose masked rows are
     rest, which is how :class:`DynamicPoseWindow` and
     :class:`MultiScaleClassifier` learn where the periods are.
@@ -104,7 +111,8 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
     random_state : int, RandomState instance or None, default=None
         Seeds the network (overrides the estimator's own ``random_state``).
     verbose : int, default=0
-        Verbosity.
+        0 is silent; 1 shows the network's progress bar over its epochs, 2 one
+        line per epoch (handed on to the network's own ``verbose``).
 
     Attributes
     ----------
@@ -126,6 +134,13 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
     -----
     ``predict_proba`` is the network's raw per-frame output; ``decision_function``
     is the smoothed score that ``threshold`` applies to.
+
+    Untracked frames are rest by construction (docs/design.md §1.1):
+    a masked row of the input (:class:`PoseDescriptor` masks the
+    untracked frames) or an all-zero row of a plain array gets probability and
+    score 0, so it is never active. The smoothing still runs over the
+    network's output on every frame, so the scores of tracked frames are
+    those of the paper's pipeline. ``fit`` trains on every frame, as before.
 
     Examples
     --------
@@ -211,7 +226,13 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         )
         default = default_frame_network()
         self.estimator_ = fit_inner_estimator(
-            self.estimator, default, Xf, yf, rng=rng, memory=self.memory
+            self.estimator,
+            default,
+            Xf,
+            yf,
+            rng=rng,
+            memory=self.memory,
+            verbose=self.verbose,
         )
         self.classes_ = np.array([0, 1])
         return self
@@ -227,15 +248,26 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         Returns
         -------
         list of ndarray of shape (n_frames_i, 2)
-            Columns: rest, gesture.
+            Columns: rest, gesture; ``[1, 0]`` on untracked rows.
         """
+        scores = []
+        for p, rest in zip(*self._raw_scores(X)):
+            p = np.where(rest, 0.0, p)
+            scores.append(np.column_stack([1.0 - p, p]))
+        return scores
+
+    def _raw_scores(self, X):
+        """The network's gesture probability of every frame, and the untracked rows."""
         check_is_fitted(self)
-        X = check_sequences(X, ndim=2, estimator=self, reset=False)
-        lengths = [len(x) for x in X]
-        proba = self.estimator_.predict_proba(np.concatenate(X))
+        data = check_sequences(X, ndim=2, estimator=self, reset=False)
+        rest = [
+            untracked_rows(x if isinstance(x, np.ma.MaskedArray) else d)
+            for x, d in zip(X, data)
+        ]
+        lengths = [len(x) for x in data]
+        proba = self.estimator_.predict_proba(np.concatenate(data))
         pos = proba[:, list(self.estimator_.classes_).index(1)]
-        pos = np.split(pos, np.cumsum(lengths)[:-1])
-        return [np.column_stack([1.0 - p, p]) for p in pos]
+        return np.split(pos, np.cumsum(lengths)[:-1]), rest
 
     def decision_function(self, X):
         """Smoothed gesture score of every frame.
@@ -248,9 +280,13 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         Returns
         -------
         list of ndarray of shape (n_frames_i,)
-            Loess-smoothed gesture probability.
+            Loess-smoothed gesture probability; 0 on untracked rows (set after
+            the smoothing).
         """
-        return [self._smooth(p[:, 1]) for p in self.predict_proba(X)]
+        return [
+            np.where(rest, 0.0, self._smooth(p))
+            for p, rest in zip(*self._raw_scores(X))
+        ]
 
     def predict(self, X):
         """Per-frame activity: 1 inside a period of activity, else 0.
@@ -310,6 +346,37 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         pred = np.concatenate(self.predict(X))
         return float(np.mean(pred == (np.concatenate(y) > 0)))
 
+    def get_feature_names_out(self, input_features=None):
+        """Names of the output features: the input features, unchanged.
+
+        Parameters
+        ----------
+        input_features : array-like of str or None, default=None
+            Names of the input features; ``None`` gives ``x0, x1, ...``.
+
+        Returns
+        -------
+        ndarray of str of shape (n_features_in_,)
+            The names (``transform`` only masks rows).
+        """
+        check_is_fitted(self)
+        return _check_feature_names_in(self, input_features)
+
+    def set_output(self, *, transform=None):
+        """Refuse a DataFrame output: a list of masked arrays has none.
+
+        Parameters
+        ----------
+        transform : {"default"} or None, default=None
+            Only ``"default"`` and ``None`` (no change) are accepted.
+
+        Returns
+        -------
+        self : ActivitySegmenter
+            Unchanged.
+        """
+        return refuse_set_output(self, transform)
+
     def _smooth(self, score):
         return np.asarray(loess_smooth(score, self.smooth_span))
 
@@ -322,3 +389,74 @@ class ActivitySegmenter(ClassifierMixin, TransformerMixin, BaseEstimator):
         tags.input_tags.two_d_array = False
         tags.input_tags.three_d_array = True
         return tags
+
+    # -- incremental step (docs/design.md, "Incremental steps") ----------------
+    # The state (skgesture/_incremental.py, SegmenterStream) uses the same
+    # network, loess and rules as predict; tests/test_streaming.py checks it.
+
+    def stream_init(self, **options):
+        """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Parameters
+        ----------
+        **options
+            Options of other stages, ignored.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+        """
+        from skgesture._incremental import SegmenterStream
+
+        check_is_fitted(self)
+        return SegmenterStream(self)
+
+    def stream_step(self, state, rows):
+        """Descriptor rows in; the rows whose activity became final out.
+
+        A row is scored by the network, its smoothed score is known ``h =
+        (smooth_span - 1) / 2`` rows later (:attr:`stream_lookahead`), and an
+        active row is handed on once its run of active rows reaches
+        ``min_length``. The output is the rows of :meth:`transform`: the
+        descriptors, masked where at rest (untracked rows included).
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next descriptor rows.
+
+        Returns
+        -------
+        out : Rows
+            Rows handed on, masked at rest.
+        state : object
+            The updated state.
+        """
+        return state.step(rows), state
+
+    def stream_flush(self, state):
+        """End of the stream: the last rows, with loess end-point fits.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : Rows
+            The remaining rows.
+        state : object
+            The spent state.
+        """
+        return state.flush(), state
+
+    @property
+    def stream_lookahead(self):
+        """Frames of smoothing look-ahead, ``(smooth_span - 1) // 2`` (7)."""
+        from skgesture._incremental import check_stream_span
+
+        return (check_stream_span(self.smooth_span, "smooth_span") - 1) // 2

@@ -73,7 +73,7 @@ class SkeletonLayout:
         return tuple(self.index(n) for n in names)
 
 
-# Kinect for Windows SDK v1 order, METHOD_SPEC §1.4.
+# Kinect for Windows SDK v1 order, docs/method.md §1.4.
 KINECT_V1 = SkeletonLayout(
     name="kinect_v1",
     joint_names=(
@@ -122,7 +122,7 @@ KINECT_V1 = SkeletonLayout(
     root="HipCenter",
 )
 
-N_KINECT_JOINTS = KINECT_V1.n_joints  # METHOD_SPEC §1.4
+N_KINECT_JOINTS = KINECT_V1.n_joints  # docs/method.md §1.4
 N_COORDS = 3  # world x, y, z in metres
 
 
@@ -138,12 +138,12 @@ class DescriptorJoints:
         Joints kept in the descriptor, in feature order; the first is the root.
     links : tuple of (str, str)
         Link-length normalisation tree ``(parent, child)``, parents first
-        (METHOD_SPEC §3.5). May pass through joints that are not kept.
+        (docs/method.md §3.5). May pass through joints that are not kept.
     triples : tuple of (str, str, str)
         Joint triples ``(i, j, k)`` for the inclination and azimuth angles
-        (METHOD_SPEC §3.9-3.10).
+        (docs/method.md §3.9-3.10).
     torso : tuple of str
-        Joints whose best-fit plane gives the body frame (METHOD_SPEC §3.8).
+        Joints whose best-fit plane gives the body frame (docs/method.md §3.8).
     left_right : tuple of (str, str)
         ``(ShoulderLeft, ShoulderRight)``-style pair giving the body's x axis sign.
     spine : tuple of (str, str)
@@ -184,7 +184,7 @@ class DescriptorJoints:
 
 _UPPER_BODY = frozenset(KINECT_V1.joint_names[:13]) | {"HipRight"}  # no legs
 
-# The paper's 11 upper-body joints, METHOD_SPEC §3.1 (decision D1), the 13-link
+# The paper's 11 upper-body joints, docs/method.md §3.1 (decision D1), the 13-link
 # upper-body tree of §3.5 and the 9 triples of §3.9 (decision D6).
 PAPER_11 = DescriptorJoints(
     name="paper11",

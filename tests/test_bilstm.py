@@ -21,18 +21,20 @@ from sklearn.pipeline import Pipeline  # noqa: E402
 from skgesture import BiLSTMTagger, PoseDescriptor, make_method_c  # noqa: E402
 from skgesture._bilstm import (  # noqa: E402
     IGNORE_INDEX,
+    PAPER_MODULE,
     _BiLSTMModule,
     _BiLSTMNet,
     _chunks,
     _SequenceHoldout,
-    _StepCrossEntropy,
     _training_windows,
     sample_windows,
 )
+from skgesture._modules import RecurrentTaggerModule  # noqa: E402
+from skgesture._networks import FramewiseLoss  # noqa: E402
 from skgesture.metrics import jaccard_index  # noqa: E402
 from skgesture.utils._testing import make_skeleton_stream  # noqa: E402
 
-# METHOD_SPEC §7.3: learning rate of 1-based epochs 1..10, 11..20, 21 and 150.
+# docs/method.md §7.3: learning rate of 1-based epochs 1..10, 11..20, 21 and 150.
 LR_GT = {1: 0.01, 10: 0.01, 11: 0.0085, 20: 0.0085, 21: 0.007225, 150: 0.001028}
 LR_RTOL = 5e-4  # the spec gives 4 significant digits
 
@@ -123,6 +125,17 @@ def test_sample_windows_switches_step_with_window_content():
     )
 
 
+def test_sample_windows_counts_the_last_frame_of_a_window():
+    # docs/method.md §7.1: a window whose only gesture frame is its last one is not
+    # all rest, so the next window starts gesture_step (2) frames later
+    y = np.zeros(30, int)
+    y[9] = 1
+    assert_array_equal(sample_windows(y)[:3], [0, 2, 4])
+    y = np.zeros(30, int)
+    y[10] = 1  # just outside the first window: it is all rest
+    assert_array_equal(sample_windows(y)[:3], [0, 5, 7])
+
+
 def test_sample_windows_short_and_empty_sequences():
     assert_array_equal(sample_windows(np.ones(7, int)), [0])
     assert_array_equal(sample_windows(np.zeros(10, int)), [0])
@@ -161,10 +174,16 @@ def test_sequence_holdout_keeps_sequences_whole():
 # -- network, loss, optimiser ----------------------------------------------------
 
 
+def _paper_module(n_inputs, n_outputs, hidden_sizes, dropout):
+    return RecurrentTaggerModule(
+        n_inputs, n_outputs, hidden_sizes, dropout=dropout, **PAPER_MODULE
+    )
+
+
 def test_module_initialisation_follows_matlab_defaults():
     torch.manual_seed(0)
-    m = _BiLSTMModule(5, 3, hidden_sizes=(4, 3), dropout=0.5)
-    lstm = m.lstms[0]
+    m = _paper_module(5, 3, hidden_sizes=(4, 3), dropout=0.5)
+    lstm = m.layers[0]
     H = 4
     assert_allclose(lstm.bias_ih_l0[H : 2 * H].detach(), 1.0)  # forget gate
     assert_allclose(lstm.bias_ih_l0[:H].detach(), 0.0)
@@ -174,13 +193,13 @@ def test_module_initialisation_follows_matlab_defaults():
     assert_allclose(W.T @ W, np.eye(H), atol=1e-5)  # orthogonal
     bound = np.sqrt(6.0 / (5 + 4 * H))  # Glorot uniform on (4H, n_inputs)
     assert np.abs(lstm.weight_ih_l0.detach().numpy()).max() <= bound
-    assert m.lstms[1].input_size == 2 * H
+    assert m.layers[1].input_size == 2 * H
     assert m.head.in_features == 6 and m.head.out_features == 3
     assert m(torch.zeros(2, 7, 5)).shape == (2, 7, 3)
 
 
 def test_module_leaky_relu_and_dropout_only_between_lstms():
-    m = _BiLSTMModule(3, 2, hidden_sizes=(4, 4, 2), dropout=0.6)
+    m = _paper_module(3, 2, hidden_sizes=(4, 4, 2), dropout=0.6)
     assert m.activation.negative_slope == 0.01
     assert m.dropout.p == 0.6
     calls = []
@@ -191,12 +210,43 @@ def test_module_leaky_relu_and_dropout_only_between_lstms():
     assert calls == ["act", "drop", "act", "drop"]
 
 
+def test_bilstm_module_of_saved_taggers_still_loads():
+    # Taggers saved before Method C's network became RecurrentTaggerModule hold
+    # a _BiLSTMModule whose layers are called `lstms`: pickles and model files
+    # (state dicts) of them load, with the same initial draws and outputs.
+    torch.manual_seed(0)
+    new = _paper_module(5, 3, (4, 3), 0.0).eval()
+    torch.manual_seed(0)
+    old = _BiLSTMModule(5, 3, hidden_sizes=(4, 3), dropout=0.0).eval()
+    x = torch.randn(2, 7, 5)
+    assert torch.equal(old(x), new(x))
+    state = {k.replace("layers.", "lstms.", 1): v for k, v in new.state_dict().items()}
+    fresh = _BiLSTMModule(5, 3, hidden_sizes=(4, 3), dropout=0.0).eval()
+    fresh.load_state_dict(state)
+    assert torch.equal(fresh(x), new(x))
+    legacy = pickle.loads(pickle.dumps(old))
+    legacy.__dict__["_modules"] = {
+        ("lstms" if k == "layers" else k): v for k, v in legacy._modules.items()
+    }
+    del legacy.__dict__["cell"]
+    loaded = pickle.loads(pickle.dumps(legacy))
+    assert torch.equal(loaded(x), new(x))
+
+
+def test_network_is_the_shared_recurrent_module(fitted):
+    module = fitted.net_.module_
+    assert type(module) is RecurrentTaggerModule and module.cell == "lstm"
+    assert isinstance(module.layers[0], torch.nn.LSTM)
+    assert fitted.net_.criterion_.time_reduction == "sum"
+    assert fitted.get_params().keys().isdisjoint({"smoothing", "max_gap"})
+
+
 def test_step_cross_entropy_sum_is_steps_times_mean():
     torch.manual_seed(0)
     logits = torch.randn(3, 10, 4)
     target = torch.randint(0, 4, (3, 10))
-    total = _StepCrossEntropy("sum")(logits, target).item()
-    mean = _StepCrossEntropy("mean")(logits, target).item()
+    total = FramewiseLoss("sum")(logits, target).item()
+    mean = FramewiseLoss("mean")(logits, target).item()
     ref = torch.nn.functional.cross_entropy(logits.reshape(-1, 4), target.reshape(-1))
     assert_allclose(mean, ref.item(), rtol=1e-6)
     assert_allclose(total, 10 * mean, rtol=1e-6)
@@ -205,7 +255,7 @@ def test_step_cross_entropy_sum_is_steps_times_mean():
         logits[0, :5], target[0, :5], reduction="sum"
     )
     assert_allclose(
-        _StepCrossEntropy("sum")(logits[:1], target[:1]).item(), ref.item(), rtol=1e-6
+        FramewiseLoss("sum")(logits[:1], target[:1]).item(), ref.item(), rtol=1e-6
     )
 
 
@@ -276,11 +326,11 @@ def test_min_run_turns_short_runs_to_rest(fitted):
     track[:, 0] = 0.5
     track[2:8, 1] = 0.9
     track[8:28, 2] = 0.9
-    tagger = clone(fitted).set_params(min_run=7)
+    tagger = clone(fitted).set_params(min_run=7, smooth_span=1)  # span 1: as is
     tagger.classes_ = fitted.classes_
-    assert_array_equal(tagger._decide(track), [0] * 8 + [2] * 20 + [0] * 2)
+    assert_array_equal(tagger._decode(track), [0] * 8 + [2] * 20 + [0] * 2)
     tagger.set_params(min_run=6)
-    assert_array_equal(tagger._decide(track), [0] * 2 + [1] * 6 + [2] * 20 + [0] * 2)
+    assert_array_equal(tagger._decode(track), [0] * 2 + [1] * 6 + [2] * 20 + [0] * 2)
 
 
 def test_min_run_and_smooth_span_change_predictions_without_refit(fitted, toy_test):
@@ -589,3 +639,32 @@ def test_pipeline_and_grid_search_over_min_run(tmp_path, monkeypatch):
     scores = search.cv_results_["mean_test_score"]
     assert scores.shape == (2,) and np.all((scores >= 0) & (scores <= 1))
     assert search.best_params_["tagger__min_run"] in (1, 15)
+
+
+# -- values float32 cannot hold ------------------------------------------------------
+# (untracked frames are rest by construction, in every tagger:
+# tests/test_tagger_base.py)
+
+
+@pytest.mark.parametrize(
+    "value, match",
+    [(1e39, r"X\[0\] has the value 1e\+39 at frame 4"),
+     (np.inf, r"X\[0\] contains NaN or infinite values \(first at frame 4\)")],
+)  # fmt: skip
+def test_values_float32_cannot_hold_are_refused(fitted, toy, value, match):
+    X, y = toy
+    x = X[0].copy()
+    x[4, 1] = value
+    with pytest.raises(ValueError, match=match):
+        fitted.predict([x])
+    with pytest.raises(ValueError, match=match):
+        BiLSTMTagger(**TINY).fit([x] + X[1:], y)
+
+
+def test_hidden_sizes_are_validated_as_a_parameter():
+    from sklearn.utils._param_validation import InvalidParameterError
+
+    X, y = [np.zeros((20, 2))], [np.r_[np.zeros(10, int), np.ones(10, int)]]
+    for bad in [(), (0,), (4, 2.5), (True,), 8]:
+        with pytest.raises(InvalidParameterError, match="'hidden_sizes' parameter"):
+            BiLSTMTagger(**{**TINY, "hidden_sizes": bad}).fit(X, y)

@@ -24,7 +24,12 @@ from sklearn.utils.estimator_checks import (
 from sklearn.utils.validation import check_is_fitted
 
 import skgesture
-from skgesture import DynamicPoseWindow, TorchMLPClassifier
+from skgesture import (
+    DynamicPoseWindow,
+    SequenceTagger,
+    SkeletonAugmenter,
+    TorchMLPClassifier,
+)
 
 
 def _discover_estimators():
@@ -48,6 +53,9 @@ ESTIMATORS = _discover_estimators()
 
 FAST_NET = {"hidden_layer_sizes": (8,), "activations": ("tanh",), "max_epochs": 20}
 
+FAST_TAGGER = {"hidden_sizes": (4,), "max_epochs": 2, "steps_per_epoch": 3,
+               "crop_length": 16}  # fmt: skip
+
 INIT_PARAMS = {
     "TorchMLPClassifier": {**FAST_NET, "random_state": 0},
     "PoseDescriptor": {},
@@ -58,10 +66,22 @@ INIT_PARAMS = {
                              "steps": (4, 2), "threshold_short": 0.5,
                              "random_state": 0},
     "BiLSTMTagger": {"hidden_sizes": (4,), "max_epochs": 2, "random_state": 0},
+    "JointFeatures": {},
+    "SkeletonAugmenter": {},
+    "SequenceTagger": {**FAST_TAGGER, "random_state": 0},
+    "VotingTagger": {"estimators": [("a", SequenceTagger(**FAST_TAGGER)),
+                                    ("b", SequenceTagger(**FAST_TAGGER))],
+                     "random_state": 0},
 }  # fmt: skip
 
 # Estimators seeding networks through random_state.
-RANDOM_ESTIMATORS = ("ActivitySegmenter", "BiLSTMTagger", "MultiScaleClassifier")
+RANDOM_ESTIMATORS = (
+    "ActivitySegmenter",
+    "BiLSTMTagger",
+    "MultiScaleClassifier",
+    "SequenceTagger",
+    "VotingTagger",
+)
 
 # A value violating each constrained parameter (the estimators of this suite's
 # scope; check_param_validation below covers every estimator generically).
@@ -70,14 +90,14 @@ BAD_PARAMS = {
         "hidden_layer_sizes": 8, "activations": "tanh", "solver": "sgd",
         "max_epochs": 0, "learning_rate": 0.0, "batch_size": 0,
         "validation_fraction": 1.0, "test_fraction": -0.1, "max_fail": 0,
-        "device": 0, "random_state": "seed", "verbose": "loud",
+        "device": 0, "n_threads": 0, "random_state": "seed", "verbose": "loud",
     },
     "PoseDescriptor": {
         "joints": "paper12", "sigma": -1.0, "border": "wrap",
         "link_normalisation": "yes", "link_direction": "reverse", "fill": "cubic",
         "distance_scale": "head", "standardize": "yes",
     },
-    "DynamicPoseWindow": {"steps": 4, "n_poses": 0},
+    "DynamicPoseWindow": {"steps": 4, "n_poses": 0, "lazy": "yes"},
     "ActivitySegmenter": {
         "estimator": "mlp", "n_context": -1, "threshold": 1.5, "min_length": 0,
         "smooth_span": 0, "memory": 3, "random_state": "seed", "verbose": "loud",
@@ -88,6 +108,26 @@ BAD_PARAMS = {
         "threshold_long": -0.1, "min_consecutive": 0, "resize": "nearest",
         "memory": 3, "random_state": "seed", "verbose": "loud",
     },
+    "JointFeatures": {"joints": "paper12", "velocities": "yes",
+                      "accelerations": 1.5, "align": "no", "fill": "cubic",
+                      "stream_stats_window": 0, "stream_warmup": -1},
+    "SequenceTagger": {
+        "architecture": "rnn", "hidden_sizes": 8, "dropout": 1.0, "tcn_layers": 0,
+        "tcn_stages": 0, "smoothing_weight": -1.0, "crop_length": 1,
+        "batch_size": 0, "steps_per_epoch": 0, "max_epochs": 0,
+        "learning_rate": 0.0, "weight_decay": -1.0, "clip_norm": 0.0,
+        "class_weight": "inverse", "augment": "rotate", "standardize": "yes",
+        "early_stopping": "yes", "validation_fraction": 1.0,
+        "n_iter_no_change": 0, "smooth_span": 0, "smoothing": "gaussian",
+        "min_run": 0, "max_gap": -1, "memory": 3, "device": 0, "n_threads": 0,
+        "random_state": "seed", "verbose": "loud", "stream_past": -1,
+        "stream_future": 2.5,
+    },
+    "VotingTagger": {
+        "estimators": "gru", "weights": "equal", "smooth_span": 0,
+        "smoothing": "gaussian", "min_run": 0, "max_gap": -1, "n_threads": 0,
+        "random_state": "seed", "stream_past": "all", "stream_future": -1,
+    },
 }  # fmt: skip
 
 # Valid non-default values, for clone and get/set_params round trips.
@@ -96,7 +136,7 @@ OTHER_PARAMS = {
                        "link_normalisation": False, "link_direction": "simao",
                        "fill": "hold", "distance_scale": "spine",
                        "standardize": False},
-    "DynamicPoseWindow": {"steps": [3, 1], "n_poses": 5},
+    "DynamicPoseWindow": {"steps": [3, 1], "n_poses": 5, "lazy": True},
     "ActivitySegmenter": {"estimator": TorchMLPClassifier(max_epochs=3),
                           "n_context": None, "threshold": 0.7, "min_length": 4,
                           "smooth_span": 0.2, "memory": joblib.Memory(None, verbose=0),
@@ -108,12 +148,35 @@ OTHER_PARAMS = {
                              "threshold_long": 0.2, "min_consecutive": 2,
                              "resize": "pchip", "memory": "cache_dir",
                              "random_state": np.random.RandomState(4), "verbose": 1},
+    "JointFeatures": {"joints": ["HipCenter", "Head"], "velocities": False,
+                      "accelerations": True, "align": True, "fill": "hold",
+                      "stream_stats_window": 100, "stream_warmup": 5},
+    "SkeletonAugmenter": {"rotation": 5.0, "scale": 0.0, "time_warp": 0.5,
+                          "noise": 0.1},
+    "SequenceTagger": {"architecture": "tcn", "hidden_sizes": [16],
+                       "dropout": 0.2, "tcn_layers": 3, "tcn_stages": 3,
+                       "smoothing_weight": 0.15, "crop_length": 32,
+                       "batch_size": 8, "steps_per_epoch": 4, "max_epochs": 3,
+                       "learning_rate": 0.01, "weight_decay": 0.0,
+                       "clip_norm": None, "class_weight": "balanced",
+                       "augment": SkeletonAugmenter(rotation=0),
+                       "standardize": False, "early_stopping": True,
+                       "validation_fraction": 0.3, "n_iter_no_change": 2,
+                       "smooth_span": 5, "smoothing": "loess", "min_run": 3,
+                       "max_gap": 2, "memory": "cache_dir", "device": "cpu",
+                       "n_threads": None, "random_state": 7, "verbose": 1,
+                       "stream_past": 64, "stream_future": 4},
+    "VotingTagger": {"estimators": [("x", SequenceTagger(max_epochs=1))],
+                     "weights": [2.0], "smooth_span": 3, "smoothing": "loess",
+                     "min_run": 2, "max_gap": 1, "n_threads": 2,
+                     "random_state": np.random.RandomState(2), "stream_past": 0,
+                     "stream_future": 16},
     "TorchMLPClassifier": {"hidden_layer_sizes": [5, 6],
                            "activations": ["relu", "relu"], "solver": "adam",
                            "max_epochs": 7, "learning_rate": 0.1, "batch_size": 16,
                            "validation_fraction": 0.2, "test_fraction": 0.1,
-                           "max_fail": 2, "device": "cpu", "random_state": 5,
-                           "verbose": 1},
+                           "max_fail": 2, "device": "cpu", "n_threads": 2,
+                           "random_state": 5, "verbose": 1},
 }  # fmt: skip
 
 
@@ -166,6 +229,9 @@ OTHER_DATA = {
     "ActivitySegmenter": lambda X, y: ([X[0][:60]], [y[0][:60]]),
     "MultiScaleClassifier": lambda X, y: (X[:2], y[:2]),
     "BiLSTMTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
+    "JointFeatures": lambda X, y: ([x[::-1] * 1.5 for x in X], None),
+    "SequenceTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
+    "VotingTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
 }
 
 # (X, y, output method) of every sequence estimator
@@ -175,6 +241,9 @@ DATA = {
     "ActivitySegmenter": lambda: (*_features(), "decision_function"),
     "MultiScaleClassifier": lambda: (*_windows(), "predict_segments"),
     "BiLSTMTagger": lambda: (*_features(), "predict_proba"),
+    "JointFeatures": lambda: (_skeletons(), None, "transform"),
+    "SequenceTagger": lambda: (*_features(), "predict_proba"),
+    "VotingTagger": lambda: (*_features(), "predict_proba"),
 }
 
 
@@ -188,11 +257,27 @@ def _assert_same_outputs(a, b):
         assert_array_equal(u, v)
 
 
+def _assert_values_equal(value, other, key):
+    if isinstance(value, (list, tuple)) and not isinstance(value, str):
+        assert type(value) is type(other) and len(value) == len(other), key
+        for u, v in zip(value, other):
+            _assert_values_equal(u, v, key)
+    elif isinstance(value, BaseEstimator):
+        assert type(value) is type(other), key
+        _assert_params_equal(value.get_params(), other.get_params())
+    else:
+        _assert_params_equal({key: value}, {key: other})
+
+
 def _assert_params_equal(p, q):
     assert p.keys() == q.keys()
     for key, value in p.items():
         other = q[key]
-        if isinstance(value, BaseEstimator):
+        if isinstance(value, (list, tuple)) and any(
+            isinstance(v, (BaseEstimator, tuple)) for v in value
+        ):
+            _assert_values_equal(value, other, key)
+        elif isinstance(value, BaseEstimator):
             assert type(value) is type(other), key
             _assert_params_equal(value.get_params(), other.get_params())
         elif isinstance(value, np.ndarray):
@@ -222,7 +307,8 @@ def test_every_public_estimator_has_fast_settings_and_data():
     assert set(ESTIMATORS) == set(INIT_PARAMS), (
         "INIT_PARAMS must list every public estimator (and only those)"
     )
-    assert set(DATA) == set(ESTIMATORS) - {"TorchMLPClassifier"}
+    # 2-D estimators and parameter objects take no list of sequences.
+    assert set(DATA) == set(ESTIMATORS) - {"TorchMLPClassifier", "SkeletonAugmenter"}
 
 
 # --------------------------------------------------------------------------------
@@ -260,12 +346,14 @@ class _Sentinel:
 @pytest.mark.parametrize("name", ALL)
 def test_init_stores_every_parameter_unchanged(name):
     cls = ESTIMATORS[name]
-    params = {key: _Sentinel() for key in cls().get_params(deep=False)}
+    keys = cls(**INIT_PARAMS[name]).get_params(deep=False)  # some have required args
+    params = {key: _Sentinel() for key in keys}
     est = cls(**params)
     for key, value in params.items():
         assert est.get_params(deep=False)[key] is value, key
         assert getattr(est, key) is value, key
-    assert not [k for k in vars(cls()) if k.endswith("_")]  # nothing fitted yet
+    # nothing fitted yet
+    assert not [k for k in vars(cls(**INIT_PARAMS[name])) if k.endswith("_")]
 
 
 @pytest.mark.parametrize("name", ALL)
@@ -280,7 +368,7 @@ def test_clone_has_equal_params_and_is_unfitted(name):
 def test_get_params_set_params_round_trip(name):
     cls = ESTIMATORS[name]
     params = OTHER_PARAMS.get(name, INIT_PARAMS[name])
-    est = cls().set_params(**cls(**params).get_params(deep=False))
+    est = cls(**INIT_PARAMS[name]).set_params(**cls(**params).get_params(deep=False))
     _assert_params_equal(est.get_params(), cls(**params).get_params())
 
 
@@ -365,7 +453,7 @@ def test_invalid_parameter_value_raises_invalid_parameter_error(name, param):
 
 @pytest.mark.parametrize("name", VALIDATED)
 def test_every_parameter_has_a_constraint_and_a_bad_value(name):
-    params = set(ESTIMATORS[name]().get_params(deep=False))
+    params = set(ESTIMATORS[name](**INIT_PARAMS[name]).get_params(deep=False))
     assert set(ESTIMATORS[name]._parameter_constraints) == params
     assert set(BAD_PARAMS[name]) == params
 

@@ -1,4 +1,4 @@
-"""PoseDescriptor and its helpers against METHOD_SPEC §3 (layout, worked examples,
+"""PoseDescriptor and its helpers against docs/method.md §3 (layout, worked examples,
 test vectors) and brute-force re-computations written straight from the spec."""
 
 from itertools import combinations
@@ -19,7 +19,7 @@ from skgesture._descriptor import (
 from skgesture.layouts import KINECT_V1, PAPER_11
 
 # --------------------------------------------------------------------------------
-# Reference values (METHOD_SPEC §3)
+# Reference values (docs/method.md §3)
 # --------------------------------------------------------------------------------
 
 # §3.1: the 11 joints, in feature order.
@@ -717,3 +717,107 @@ def test_descriptor_returns_one_array_per_sequence_with_same_frames(stream):
     Z = PoseDescriptor().fit(X).transform(X)
     assert isinstance(Z, list)
     assert [z.shape for z in Z] == [(40, 183), (7, 183), (3, 183)]
+
+
+# --------------------------------------------------------------------------------
+# Untracked frames: masked output, masked input (issue 11)
+# --------------------------------------------------------------------------------
+
+
+def test_descriptor_masks_the_rows_of_untracked_frames(stream):
+    seq = stream.copy()
+    seq[5] = 0.0  # all zeros
+    seq[9, 4, 1] = np.nan  # one NaN joint
+    desc = PoseDescriptor().fit([stream])
+    Z = desc.transform([seq, stream])
+    assert isinstance(Z[0], np.ma.MaskedArray)
+    rows = np.isin(np.arange(len(seq)), [5, 9])
+    assert_array_equal(np.ma.getmaskarray(Z[0]), np.repeat(rows[:, None], 183, 1))
+    assert np.isfinite(Z[0].data).all()  # the filled frames are described as before
+    assert not isinstance(Z[1], np.ma.MaskedArray)  # nothing untracked: plain
+    untracked = desc.transform([np.zeros((6, 20, 3))])[0]
+    assert np.ma.getmaskarray(untracked).all()
+
+
+def test_descriptor_default_fill_is_linear(stream):
+    # docs/method.md §3.3, decision D11: interpolate between the tracked neighbours
+    assert PoseDescriptor().fill == "linear"
+    seq = stream.copy()
+    seq[10:13] = 0.0
+    by_hand = stream.copy()
+    for k, t in enumerate(range(10, 13), start=1):
+        by_hand[t] = stream[9] + k * (stream[13] - stream[9]) / 4
+    desc = PoseDescriptor().fit([stream])
+    assert_allclose(desc.transform([seq])[0].data, desc.transform([by_hand])[0])
+    hold = PoseDescriptor(fill="hold").fit([stream]).transform([seq])[0].data
+    assert not np.allclose(hold, desc.transform([seq])[0].data)
+
+
+def test_descriptor_ignores_what_lies_under_the_mask_of_a_masked_input(stream):
+    garbage = stream.copy()
+    garbage[10:14] = 1e3  # what a broken sensor might leave under the mask
+    garbage[20, 3] = np.inf
+    mask = np.zeros(stream.shape, dtype=bool)
+    mask[10:14] = True
+    mask[20, 3] = True  # one masked joint marks the frame untracked
+    masked = np.ma.MaskedArray(garbage, mask=mask)
+    nan = stream.copy()
+    nan[10:14] = np.nan
+    nan[20, 3] = np.nan
+    desc = PoseDescriptor().fit([stream])
+    Z, ref = desc.transform([masked])[0], desc.transform([nan])[0]
+    assert_array_equal(Z.data, ref.data)
+    assert_array_equal(
+        np.ma.getmaskarray(Z)[:, 0], np.isin(range(40), [10, 11, 12, 13, 20])
+    )
+    # fit honours the mask too
+    fitted = PoseDescriptor().fit([masked])
+    assert_allclose(fitted.mean_, PoseDescriptor().fit([nan]).mean_)
+
+
+@pytest.mark.parametrize(
+    "scale, value, message",
+    [
+        (1e200, np.nan, r"X\[1\] has the value .* at frame 0, beyond the accepted "
+         r"magnitude 1e\+05"),  # squared norms would overflow to NaN
+        (1.0, 2e5, r"X\[1\] has the value 2e\+05 at frame 7"),
+        (1.0, -np.inf, r"X\[1\] contains infinite values \(first at frame 7\)"),
+    ],
+)  # fmt: skip
+def test_descriptor_refuses_absurd_coordinates(stream, scale, value, message):
+    bad = stream * scale
+    if not np.isnan(value):
+        bad[7, 2, 1] = value
+    desc = PoseDescriptor().fit([stream])
+    with pytest.raises(ValueError, match=message):
+        desc.transform([stream, bad])
+    with pytest.raises(ValueError, match=message):
+        PoseDescriptor().fit([stream, bad])
+
+
+def test_descriptor_accepts_coordinates_in_millimetres(stream):
+    Z = PoseDescriptor().fit_transform([stream * 1000.0])[0]
+    assert np.isfinite(Z).all()
+
+
+def test_descriptor_refuses_joints_changed_after_fit(stream):
+    desc = PoseDescriptor().fit([stream]).set_params(joints="full20")
+    for method in (desc.transform, lambda X: desc.get_feature_names_out()):
+        with pytest.raises(ValueError, match=r"fitted for 'paper11' \(183 features\) "
+                           r"but joints is now 'full20' \(426 features\)"):  # fmt: skip
+            method([stream])
+    desc.set_params(joints="paper11")
+    assert desc.transform([stream])[0].shape == (40, 183)
+
+
+def test_descriptor_output_container_stays_a_list_of_arrays(stream):
+    import sklearn
+
+    desc = PoseDescriptor()
+    assert desc.set_output(transform="default") is desc
+    assert desc.set_output() is desc
+    with pytest.raises(ValueError, match="list of per-sequence arrays"):
+        desc.set_output(transform="pandas")
+    with sklearn.config_context(transform_output="pandas"):
+        Z = PoseDescriptor().fit_transform([stream])
+    assert isinstance(Z, list) and isinstance(Z[0], np.ndarray)

@@ -1,4 +1,7 @@
-"""Tests of skgesture.metrics against hand-computed values (METHOD_SPEC §2, §11.3)."""
+"""Tests of skgesture.metrics against hand-computed values.
+
+docs/method.md §2 and §11.3.
+"""
 
 import warnings
 
@@ -28,7 +31,7 @@ from skgesture.metrics import (
 
 MODES = ("official_2014", "fp_penalised", "inclusive")
 
-# METHOD_SPEC §2.4: n = 10, GT lines 3,2,6 and 5,7,10; prediction 3,3,6 and 8,7,9.
+# docs/method.md §2.4: n = 10, GT lines 3,2,6 and 5,7,10; prediction 3,3,6 and 8,7,9.
 N_WORKED = 10
 GT_WORKED = [[3, 2, 6], [5, 7, 10]]
 PRED_WORKED = [[3, 3, 6], [8, 7, 9]]
@@ -558,3 +561,119 @@ def test_make_sequence_scorer_passes_keyword_arguments():
     assert repr(scorer) == "make_sequence_scorer(jaccard_index, mode='inclusive')"
     with pytest.raises(TypeError, match="callable"):
         make_sequence_scorer("jaccard")
+
+
+# --------------------------------------------------------------------------------
+# Official (segment-file) score vs per-frame score; absurd labels (issue 11)
+# --------------------------------------------------------------------------------
+
+# Issue 11: GT lines 3,11,40 and 3,41,70 (touching instances of one class),
+# prediction 3,11,70; 1-based inclusive file lines, 80 frames.
+TOUCHING_GT_LINES = [[3, 11, 40], [3, 41, 70]]
+TOUCHING_PRED_LINES = [[3, 11, 70]]
+TOUCHING_OFFICIAL = 58 / 59  # 0.98305: one end frame dropped per GT instance
+
+
+def test_per_frame_jaccard_differs_from_the_official_one_on_touching_instances():
+    y = np.zeros(80, int)
+    y[10:70] = 3  # what the ground truth looks like as per-frame labels
+    official = jaccard_index_segments(TOUCHING_GT_LINES, TOUCHING_PRED_LINES, 80)
+    assert official == pytest.approx(TOUCHING_OFFICIAL)
+    assert round(official, 5) == 0.98305
+    assert jaccard_index([y], [y]) == 1.0  # the documented difference
+    # the official path from loader-style segments (0-based, end exclusive)
+    segments = [[[3, 10, 40], [3, 40, 70]]]
+    assert jaccard_index([y], [y], true_segments=segments) == official
+    for mode in MODES:
+        assert jaccard_index(
+            [y], [y], true_segments=segments, mode=mode
+        ) == jaccard_index_segments(
+            TOUCHING_GT_LINES, TOUCHING_PRED_LINES, 80, mode=mode
+        )
+
+
+def test_jaccard_true_segments_equal_the_runs_when_instances_do_not_touch():
+    y_true, y_pred = [Y_TRUE_WORKED], [Y_PRED_WORKED]
+    segments = [labels_to_segments(Y_TRUE_WORKED)]
+    for mode in MODES:
+        assert jaccard_index(y_true, y_pred, mode=mode, true_segments=segments) == (
+            jaccard_index(y_true, y_pred, mode=mode)
+        )
+
+
+@pytest.mark.parametrize(
+    "segments, error, match",
+    [
+        ([], ValueError, "true_segments has 0 sequences but y_true has 1"),
+        ("3,10,40", TypeError, "true_segments must be a list"),
+        ([[[3, 10]]], ValueError, r"true_segments\[0\] must have shape \(n_segm"),
+        ([[[3, 10, 90]]], ValueError, r"true_segments\[0\] row 0 .* outside"),
+        ([[[3, 10.5, 40]]], ValueError, r"true_segments\[0\] row 0 .* whole number"),
+    ],
+)  # fmt: skip
+def test_jaccard_true_segments_are_validated(segments, error, match):
+    y = np.zeros(80, int)
+    y[10:70] = 3
+    with pytest.raises(error, match=match):
+        jaccard_index([y], [y], true_segments=segments)
+
+
+def test_jaccard_of_a_huge_label_allocates_one_frame_row_at_a_time():
+    import tracemalloc
+
+    y_true = [np.r_[np.zeros(50, int), np.full(100, 10**9), np.zeros(50, int)]]
+    y_pred = [np.r_[np.zeros(60, int), np.full(90, 10**9), np.zeros(50, int)]]
+    tracemalloc.start()
+    try:
+        score = jaccard_index(y_true, y_pred)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert score == pytest.approx(89 / 99)
+    assert peak < 1_000_000  # 10**9 x 200 frames would be 186 GB
+
+
+@pytest.mark.parametrize(
+    "y, match",
+    [
+        ([0, 1.7, 1.7, 0], r"frame 1 has .*1\.7"),
+        ([0, np.nan, 0], r"frame 1 has .*nan"),
+        ([0, np.inf, 0], r"frame 1 has .*inf"),
+        ([[0, 1], [1, 0]], r"must be 1-D .* shape \(2, 2\)"),
+        (["a", "b"], "must hold integers"),
+    ],
+)
+def test_labels_to_segments_rejects_non_integer_labels(y, match):
+    with pytest.raises(ValueError, match=match):
+        labels_to_segments(y)
+
+
+def test_labels_to_segments_accepts_whole_floats():
+    assert labels_to_segments([0.0, 2.0, 2.0, 0.0]).tolist() == [[2, 1, 3]]
+
+
+@pytest.mark.parametrize(
+    "segments, n_frames, match",
+    [
+        ([[1, 1.5, 3]], 5, r"row 0 = \(1\.0, 1\.5, 3\.0\) holds a value that is not"),
+        ([[1, 1, 3.2]], 5, "not a whole number"),
+        ([[1, 1, np.nan]], 5, "not a whole number"),
+        ([[1.5, 1, 3]], 5, "not a whole number"),
+        ([[1, 1]], 5, r"shape \(n_segments, 3\) .* got shape \(1, 2\)"),
+        ([[1, 1], [2, 2], [3, 3]], 5, r"got shape \(3, 2\)"),  # not read as 2 rows
+        ([1, 1, 3], 5, r"got shape \(3,\)"),
+        ([[1, 1, 3]], -5, "n_frames must be a non-negative integer, got -5"),
+        ([[1, 1, 3]], 5.5, "n_frames must be a non-negative integer"),
+        ([[1, 0, 1e30]], 5, "outside|overflows"),
+        ([["a", 1, 3]], 5, "must hold integers"),
+    ],
+)
+def test_segments_to_labels_rejects_malformed_segments(segments, n_frames, match):
+    with pytest.raises(ValueError, match=match):
+        segments_to_labels(segments, n_frames)
+
+
+def test_segments_to_labels_accepts_whole_float_bounds_and_no_segment():
+    assert segments_to_labels([[2.0, 1.0, 3.0]], 4).tolist() == [0, 2, 2, 0]
+    assert segments_to_labels(np.zeros((0, 3)), 3).tolist() == [0, 0, 0]
+    assert segments_to_labels([], 0).tolist() == []

@@ -1,4 +1,4 @@
-"""MultiScaleClassifier and the paper's decision rules (METHOD_SPEC §5.5, §6)."""
+"""MultiScaleClassifier and the paper's decision rules (docs/method.md §5.5, §6)."""
 
 import copy
 
@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.linear_model import LogisticRegression
+from sklearn.utils._param_validation import InvalidParameterError
 
 from skgesture import DynamicPoseWindow, MultiScaleClassifier, TorchMLPClassifier
 from skgesture._multiscale import decide_period
@@ -365,20 +366,42 @@ def test_multiscale_score_is_the_jaccard_index(fitted):
     assert fitted.score(_windows(X), y) == 1.0
 
 
+WEIGHTS_ERROR = "must be a non-empty tuple of finite weights >= 0, not all 0"
+STEPS_ERROR = "'steps' parameter of MultiScaleClassifier must be a non-empty tuple"
+
+
 @pytest.mark.parametrize(
     "params, message",
     [
         ({"weights": (0.5, 0.3, 0.2)}, "weights has 3 values but steps has 2"),
-        ({"weights": (1.0, -1.0)}, "non-negative"),
-        ({"weights": (0.0, 0.0)}, "not all 0"),
         ({"steps": (4,)}, r"X has 2 scales per frame but steps=\(4,\)"),
-        ({"steps": (4, 3)}, "does not look like dynamic poses"),
-        ({"steps": ()}, "non-empty"),
+        ({"steps": (4, 3)}, r"X\[0\] does not hold dynamic poses with steps=\(4, 3\)"),
+        ({"min_windows": 900, "stride": 20}, "would resize every short period to"),
     ],
 )
 def test_multiscale_rejects_inconsistent_parameters(params, message):
     X, y = _clips([1, 2])
     with pytest.raises(ValueError, match=message):
+        _clf(**params).fit(_windows(X), y)
+
+
+@pytest.mark.parametrize(
+    "params, message",
+    [
+        ({"weights": (1.0, -1.0)}, WEIGHTS_ERROR),
+        ({"weights": (0.0, 0.0)}, WEIGHTS_ERROR),
+        ({"weights": (np.nan, 1.0)}, WEIGHTS_ERROR),
+        ({"weights": (np.inf, 1.0)}, WEIGHTS_ERROR),
+        ({"weights": np.array([1.0, np.nan])}, WEIGHTS_ERROR),
+        ({"weights": ("a", 1.0)}, WEIGHTS_ERROR),
+        ({"steps": ()}, STEPS_ERROR),
+        ({"steps": (4, 2.5)}, STEPS_ERROR),
+        ({"min_windows": 10**7}, "'min_windows' parameter of MultiScaleClassifier"),
+    ],
+)
+def test_multiscale_rejects_bad_parameter_values(params, message):
+    X, y = _clips([1, 2])
+    with pytest.raises(InvalidParameterError, match=message):
         _clf(**params).fit(_windows(X), y)
 
 
@@ -442,3 +465,165 @@ def test_multiscale_memory_reuses_scale_estimators_across_decision_params(tmp_pa
         W, y
     )
     assert len(list(tmp_path.rglob("output.pkl"))) == 2 * n_cached
+
+
+# --------------------------------------------------------------------------------
+# One source of truth for the steps (issue 11): the windows are checked
+# --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("built_with", [(5, 2), (4, 3), (2, 4), (4, 1)])
+def test_multiscale_fit_refuses_windows_built_with_other_steps(built_with):
+    X, y = _clips([1, 2, 3, 1])
+    with pytest.raises(ValueError, match=r"X\[0\] does not hold dynamic poses"):
+        _clf().fit(_windows(X, steps=built_with), y)
+
+
+def test_multiscale_step_error_names_the_step_the_windows_were_built_with():
+    X, y = _clips([1, 2])
+    with pytest.raises(ValueError, match="scale 0 .* look built with step 5 there"):
+        _clf().fit(_windows(X, steps=(5, 2)), y)
+
+
+def test_multiscale_predict_refuses_windows_built_with_other_steps(fitted):
+    # steps 4 and 5 clip to the same frame near the start: checked everywhere
+    X, _ = _clips([3, 1, 2], seed=5)
+    with pytest.raises(ValueError, match=r"does not hold dynamic poses.*\(4, 2\)"):
+        fitted.predict(_windows(X, steps=(5, 2)))
+    with pytest.raises(ValueError, match=r"X\[1\] does not hold dynamic poses"):
+        fitted.predict_segments(_windows(X[:1]) + _windows(X[1:], steps=(4, 3)))
+
+
+# --------------------------------------------------------------------------------
+# Short periods resized for the long rule (issue 11 bug): decided on the
+# resized frames, then mapped back
+# --------------------------------------------------------------------------------
+
+
+def _two_class_clip(first, second, seed=3):
+    rng = np.random.RandomState(seed)
+    x = np.concatenate(
+        [_frames(CLASS_MEANS[first], 6, rng), _frames(CLASS_MEANS[second], 6, rng)]
+    )
+    return x, np.r_[np.full(6, first), np.full(6, second)]
+
+
+def test_multiscale_long_rule_on_a_resized_period_maps_frames_back():
+    # 12 frames, one step of 4, short_length 10: the period is "long" but too
+    # short for 5 windows, so it is resized to 17 frames. The first half is
+    # class 1, the second class 2: both halves must be labelled.
+    X, y = _clips([1, 2, 3, 1, 2, 3])
+    clf = MultiScaleClassifier(
+        LogisticRegression(), steps=(4,), short_length=10, min_consecutive=2,
+        threshold_long=0.5,
+    ).fit(_windows(X, steps=(4,)), y)  # fmt: skip
+    x, truth = _two_class_clip(1, 2)
+    pred = clf.predict(_windows([x], steps=(4,)))[0]
+    # (before the fix the resized centres 4..12 were read as original frames:
+    # frames 6 and 7 went to class 1)
+    assert_array_equal(pred, truth)
+    segments = clf.predict_segments(_windows([x], steps=(4,)))[0]
+    assert_array_equal(segments[:, :3].astype(int), labels_to_segments(pred))
+
+
+@pytest.mark.parametrize("resize", ["bicubic", "pchip", "spline"])
+def test_multiscale_resized_period_short_rule_labels_every_original_frame(resize):
+    # 12 frames < short_length: one label for all 12 frames, whatever the resampler
+    X, y = _clips([1, 2, 3, 1, 2, 3])
+    clf = _clf(resize=resize).fit(_windows(X), y)
+    x, _ = _clips([2], seed=7, length=12)
+    assert_array_equal(clf.predict(_windows(x))[0], np.full(12, 2))
+
+
+def test_resized_frames_inverts_the_resampling_map():
+    from skgesture._multiscale import _resized_frames
+
+    # imresize: output u <- input (u + 0.5) L / n - 0.5, so input t -> nearest u
+    assert _resized_frames(12, 17, "bicubic").tolist() == [
+        0, 2, 3, 4, 6, 7, 9, 10, 12, 13, 14, 16,
+    ]  # fmt: skip
+    assert _resized_frames(3, 17, "pchip").tolist() == [0, 8, 16]
+    assert _resized_frames(1, 17, "spline").tolist() == [8]
+
+
+# --------------------------------------------------------------------------------
+# Untracked frames are rest by construction (issue 11)
+# --------------------------------------------------------------------------------
+
+
+def test_multiscale_all_zero_rows_are_rest_and_split_the_period(fitted):
+    X, _ = _clips([3], seed=5, length=60)
+    x = X[0].copy()
+    x[25:35] = 0.0  # untracked descriptor frames in the middle of the gesture
+    W = _windows([x])
+    zero = ~W[0].reshape(60, -1).any(axis=1)  # windows made of untracked frames only
+    assert_array_equal(np.flatnonzero(zero), [29, 30])
+    pred = fitted.predict(W)[0]
+    assert_array_equal(pred[29:31], 0)
+    assert set(pred[:25]) == {3} and set(pred[35:]) == {3}
+
+
+def test_multiscale_masked_rows_from_the_descriptor_are_rest(fitted):
+    X, _ = _clips([2], seed=6, length=60)
+    mask = np.zeros(X[0].shape, dtype=bool)
+    mask[20:30, 1] = True  # the descriptor masks every value of an untracked row
+    W = _windows([np.ma.MaskedArray(X[0], mask=mask)])
+    pred = fitted.predict(W)[0]
+    assert_array_equal(pred[20:30], 0)
+    assert set(pred[:20]) == {2} and set(pred[30:]) == {2}
+
+
+# --------------------------------------------------------------------------------
+# verbose, absurd values, paper defaults
+# --------------------------------------------------------------------------------
+
+
+def test_multiscale_verbose_shows_progress_and_is_silent_at_0(capsys):
+    X, y = _clips([1, 2, 1, 2])
+    net = TorchMLPClassifier(hidden_layer_sizes=(4,), activations=("tanh",),
+                             max_epochs=3)  # fmt: skip
+    MultiScaleClassifier(net, steps=STEPS, random_state=0).fit(_windows(X), y)
+    assert capsys.readouterr() == ("", "")
+    MultiScaleClassifier(net, steps=STEPS, random_state=0, verbose=1).fit(
+        _windows(X), y
+    )
+    assert "networks of steps (4, 2)" in capsys.readouterr().err
+    MultiScaleClassifier(net, steps=STEPS, random_state=0, verbose=2).fit(
+        _windows(X), y
+    )
+    out = capsys.readouterr().out
+    assert out.count("valid_loss") == 2  # one epoch table per scale
+    assert len([ln for ln in out.splitlines() if ln.strip()[:1].isdigit()]) >= 2
+
+
+def test_multiscale_refuses_values_beyond_float32(fitted):
+    X, _ = _clips([1, 2], seed=5)
+    W = [w.astype(np.float64) for w in _windows(X)]
+    W[1][7, 0, 2] = 1e39  # float32 would make it inf
+    with pytest.raises(ValueError, match=r"X\[1\] has the value 1e\+39 at frame 7"):
+        fitted.predict(W)
+    W[1][7, 0, 2] = np.inf
+    with pytest.raises(ValueError, match=r"X\[1\] contains NaN or infinite values"):
+        fitted.predict(W)
+
+
+def test_multiscale_default_resize_is_the_papers_bicubic():
+    # docs/method.md §5.3 / D15, used by make_method_a and make_method_b
+    from skgesture import make_method_a, make_method_b
+
+    assert MultiScaleClassifier().resize == "bicubic"
+    for make in (make_method_a, make_method_b):
+        assert make().named_steps["classifier"].resize == "bicubic"
+    # and it is what the classifier does: a short clip gives bicubic windows
+    X, y = _clips([1, 2, 3, 1, 2, 3])
+    W = _windows(X)
+    default = _clf().fit(W, y)
+    x, _ = _clips([2], seed=7, length=12)
+    Wx = _windows(x)
+    for resize, same in (("bicubic", True), ("pchip", False)):
+        other = _clf(resize=resize).fit(W, y)
+        probs = [
+            clf.estimators_[0].predict_proba(clf._windows(Wx[0], 0, 12, STEPS)[0][:, 0])
+            for clf in (default, other)
+        ]
+        assert np.array_equal(*probs) is same

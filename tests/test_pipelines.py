@@ -22,7 +22,7 @@ from skgesture import (
 from skgesture.datasets import make_gesture_streams
 from skgesture.metrics import jaccard_index, jaccard_scorer
 
-# METHOD_SPEC §4.4, §5.5, §6.1-§6.3
+# docs/method.md §4.4, §5.5, §6.1-§6.3
 STEPS_A, STEPS_B = (4,), (4, 3, 2)
 WEIGHTS_B = (0.4895, 0.4576, 0.0529)
 THRESHOLDS_A = (0.8717, 0.6255)  # short, long
@@ -233,3 +233,155 @@ def test_method_a_grid_search_trains_each_network_once_per_fold(streams, tmp_pat
     best = search.best_estimator_.named_steps
     assert best["segmenter"].threshold == search.best_params_["segmenter__threshold"]
     assert len(search.predict(streams.X)) == len(streams.X)
+
+
+# --------------------------------------------------------------------------------
+# Untracked frames are rest by construction, in every method (issue 11)
+# --------------------------------------------------------------------------------
+
+
+class _SaysGesture(torch.nn.Module):
+    """Stand-in BiLSTM whose logits always favour class index 1 (a gesture)."""
+
+    def __init__(self, n_classes):
+        super().__init__()
+        self.bias = torch.nn.Parameter(torch.zeros(n_classes))
+        with torch.no_grad():
+            self.bias[1] = 5.0
+
+    def forward(self, X):
+        return self.bias.expand(*X.shape[:2], -1)
+
+
+@pytest.fixture(scope="module")
+def eager_models(streams):
+    """Methods A, B and C whose networks see a gesture in every frame.
+
+    Whatever such a model is shown, only the untracked-frame rule can make it
+    say rest, so the tests below fail if that rule is missing.
+    """
+    from sklearn.dummy import DummyClassifier
+
+    from skgesture import make_method_c
+
+    models = {}
+    for name, make in (("A", make_method_a), ("B", make_method_b)):
+        models[name] = make(random_state=0).set_params(
+            segmenter__estimator=DummyClassifier(strategy="constant", constant=1),
+            classifier__estimator=DummyClassifier(strategy="most_frequent"),
+        )
+        models[name].fit(streams.X, streams.y)
+    c = make_method_c(random_state=0).set_params(
+        tagger__hidden_sizes=(4,), tagger__max_epochs=1
+    )
+    c.fit(streams.X, streams.y)
+    tagger = c.named_steps["tagger"]
+    tagger.net_.module_ = _SaysGesture(len(tagger.classes_))
+    models["C"] = c
+    return models
+
+
+@pytest.mark.parametrize("method", ["A", "B", "C"])
+def test_an_untracked_sequence_is_all_rest(eager_models, streams, method):
+    model = eager_models[method]
+    assert (model.predict([streams.X[0]])[0] != 0).mean() > 0.8  # eager indeed
+    for untracked in (np.zeros((200, 20, 3)), np.full((200, 20, 3), np.nan)):
+        assert_array_equal(model.predict([untracked])[0], 0)
+
+
+def test_the_segmenter_reports_no_activity_on_an_untracked_sequence(eager_models):
+    pipe = eager_models["A"]
+    D = pipe.named_steps["descriptor"].transform([np.zeros((200, 20, 3))])
+    assert np.ma.getmaskarray(D[0]).all()  # every frame untracked
+    segmenter = pipe.named_steps["segmenter"]
+    assert_array_equal(segmenter.predict(D)[0], 0)
+    assert_array_equal(segmenter.decision_function(D)[0], 0.0)
+
+
+@pytest.mark.parametrize("method", ["A", "B", "C"])
+def test_a_tracking_gap_inside_a_gesture_is_rest(eager_models, streams, method):
+    x = streams.X[0].copy()
+    gap = slice(100, 112)
+    x[gap] = 0.0  # tracking lost for 12 frames
+    masked = np.ma.MaskedArray(streams.X[0], mask=np.zeros(x.shape, dtype=bool))
+    masked[gap] = np.ma.masked  # the same gap as a masked input
+    model = eager_models[method]
+    for seq in (x, masked):
+        pred = model.predict([seq])[0]
+        assert_array_equal(pred[gap], 0)
+        assert (pred[:100] != 0).mean() > 0.8 and (pred[112:] != 0).mean() > 0.8
+
+
+# --------------------------------------------------------------------------------
+# Changed parameters of a fitted pipeline: errors, not different labels
+# --------------------------------------------------------------------------------
+
+
+def test_window_steps_that_disagree_with_the_classifier_are_refused(streams):
+    pipe = _small(make_method_b(random_state=0))
+    pipe.set_params(windows__steps=(5, 3, 2))
+    with pytest.raises(ValueError, match=r"X\[0\] does not hold dynamic poses with"):
+        pipe.fit(streams.X, streams.y)
+
+
+def test_changing_the_window_steps_of_a_fitted_pipeline_fails_at_predict(
+    fitted_a, streams
+):
+    try:
+        fitted_a.set_params(windows__steps=(5,))
+        with pytest.raises(ValueError, match="does not hold dynamic poses with"):
+            fitted_a.predict(streams.X[:1])
+    finally:
+        fitted_a.set_params(windows__steps=(4,))  # fitted_a is shared
+    assert fitted_a.predict(streams.X[:1])[0].shape == streams.y[0].shape
+
+
+def test_changing_the_joints_of_a_fitted_pipeline_fails_clearly(fitted_a, streams):
+    try:
+        fitted_a.set_params(descriptor__joints="full20")
+        with pytest.raises(ValueError, match=r"fitted for 'paper11' \(183 features"):
+            fitted_a.predict(streams.X[:1])
+    finally:
+        fitted_a.set_params(descriptor__joints="paper11")
+    assert fitted_a.predict(streams.X[:1])[0].shape == streams.y[0].shape
+
+
+# --------------------------------------------------------------------------------
+# verbose and output containers (issue 9)
+# --------------------------------------------------------------------------------
+
+
+def test_factories_verbose_shows_progress_only_when_asked(streams, capsys):
+    X, y = streams.X[:2], streams.y[:2]
+    _small(make_method_a(random_state=0)).fit(X, y)
+    assert capsys.readouterr() == ("", "")
+    _small(make_method_a(random_state=0, verbose=1)).fit(X, y)
+    err = capsys.readouterr().err
+    assert "MultiScaleClassifier: networks of steps (4,)" in err
+    assert "epoch" in err
+    _small(make_method_b(random_state=0, verbose=2)).fit(X, y)
+    out = capsys.readouterr().out
+    assert out.count("train_loss") == 1 + 3  # segmenter + one network per scale
+
+
+def test_a_global_pandas_output_setting_does_not_break_fit(streams):
+    import sklearn
+
+    X, y = streams.X[:2], streams.y[:2]
+    expected = _small(make_method_b(random_state=0)).fit(X, y).predict(X)
+    with sklearn.config_context(transform_output="pandas"):
+        pipe = _small(make_method_b(random_state=0)).fit(X, y)
+        pred = pipe.predict(X)
+    for a, b in zip(pred, expected):
+        assert_array_equal(a, b)
+    with pytest.raises(ValueError, match="PoseDescriptor.set_output.*not supported"):
+        pipe.set_output(transform="pandas")
+
+
+def test_pipeline_feature_names_reach_the_windows(fitted_a):
+    names = fitted_a[:-1].get_feature_names_out()
+    assert len(names) == 3 * 183
+    assert names[0] == "step4_t-4_pos_HipCenter_x"
+    descriptor = fitted_a.named_steps["descriptor"].get_feature_names_out()
+    assert names[183 + 182] == f"step4_t+0_{descriptor[182]}"
+    assert names[-1] == "step4_t+4_dist_HipLeft_HipRight"

@@ -1,4 +1,4 @@
-"""Time resampling of frame matrices (METHOD_SPEC §8.5, decision D15)."""
+"""Time resampling of frame matrices (docs/method.md §8.5, decision D15)."""
 
 import math
 
@@ -8,13 +8,13 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from skgesture.utils._resize import imresize_weights, resize_frames
 
-# METHOD_SPEC §8.5 test vector: column (0, 1, 0, 2) resized to 9 rows (4 decimals).
+# docs/method.md §8.5 test vector: column (0, 1, 0, 2) resized to 9 rows (4 decimals).
 COLUMN_GT = np.array([0.0, 1.0, 0.0, 2.0])
 RESIZED_9_GT = np.array(
     [-0.1003, 0.1319, 0.7101, 0.9896, 0.4375, -0.0159, 0.6523, 1.7477, 2.2006]
 )
 ATOL_4DP = 5e-5
-N_MIN_FRAMES = 17  # METHOD_SPEC §5.3: short segments are enlarged to 17 frames
+N_MIN_FRAMES = 17  # docs/method.md §5.3: short segments are enlarged to 17 frames
 
 
 def _keys(x):
@@ -34,7 +34,7 @@ def _mirror(j, n):
 
 
 def _scalar_imresize(col, m):
-    """Scalar-loop transcription of METHOD_SPEC §8.5 (with antialiasing)."""
+    """Scalar-loop transcription of docs/method.md §8.5 (with antialiasing)."""
     n = len(col)
     scale = m / n
     shrink = scale < 1

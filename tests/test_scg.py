@@ -1,4 +1,4 @@
-"""SCG (METHOD_SPEC §8.6, §11 item 9) on problems with known answers."""
+"""SCG (docs/method.md §8.6, §11 item 9) on problems with known answers."""
 
 import math
 
@@ -9,8 +9,8 @@ from numpy.testing import assert_allclose
 
 from skgesture.utils._scg import SCG
 
-SIGMA_GT = 5.0e-5  # METHOD_SPEC §8.6.1
-LAMBDA_GT = 5.0e-7  # METHOD_SPEC §8.6.1
+SIGMA_GT = 5.0e-5  # docs/method.md §8.6.1
+LAMBDA_GT = 5.0e-7  # docs/method.md §8.6.1
 ROSENBROCK_START = (-1.2, 1.0)
 ROSENBROCK_MIN = np.array([1.0, 1.0])
 
@@ -74,7 +74,7 @@ def _make(fun, w0, dtype=torch.float64, **kwargs):
 
 
 def _reference_scg(fun, grad, w, n_epochs, sigma=SIGMA_GT, lambd=LAMBDA_GT):
-    """Line-by-line numpy transcription of the METHOD_SPEC §8.6.2 pseudo-code."""
+    """Line-by-line numpy transcription of the docs/method.md §8.6.2 pseudo-code."""
     w = np.array(w, dtype=float)
     n = w.size
     e, g = fun(w), grad(w)

@@ -1,4 +1,4 @@
-"""ActivitySegmenter (METHOD_SPEC §4): training frames, periods, masks, caching."""
+"""ActivitySegmenter (docs/method.md §4): training frames, periods, masks, caching."""
 
 import copy
 
@@ -237,3 +237,98 @@ def test_segmenter_memory_reuses_the_network_across_decision_params(train, tmp_p
     # so does a change of the training frames
     ActivitySegmenter(_net(), memory=memory, n_context=5).fit([X], [y])
     assert _n_cached(tmp_path) == 3
+
+
+# --------------------------------------------------------------------------------
+# Untracked frames are rest by construction (issue 11)
+# --------------------------------------------------------------------------------
+
+
+class _AlwaysGesture(LogisticRegression):
+    """A frame classifier that calls every frame a gesture, whatever it sees."""
+
+    def predict_proba(self, X):
+        return np.tile([0.0, 1.0], (len(X), 1))
+
+
+@pytest.fixture(scope="module")
+def always_active(train):
+    X, y = train
+    return ActivitySegmenter(_AlwaysGesture()).fit([X], [y])
+
+
+def test_segmenter_reports_no_activity_on_masked_rows(always_active, test_stream):
+    X, _ = test_stream
+    mask = np.zeros(X.shape, dtype=bool)
+    mask[40:60] = True  # untracked frames inside the first gesture
+    x = np.ma.MaskedArray(X, mask=mask)
+    assert always_active.predict([X])[0].all()  # the network sees activity...
+    active = always_active.predict([x])[0]
+    assert_array_equal(active, np.r_[np.ones(40), np.zeros(20), np.ones(len(X) - 60)])
+    assert_array_equal(always_active.decision_function([x])[0][40:60], 0.0)
+    assert_array_equal(always_active.predict_proba([x])[0][40:60], [[1.0, 0.0]] * 20)
+    # the smoothing of tracked frames is unchanged: their scores stay 1
+    assert_allclose(always_active.decision_function([x])[0][:40], 1.0)
+    out = always_active.transform([x])[0]
+    assert np.ma.getmaskarray(out)[40:60].all()
+
+
+def test_segmenter_all_zero_features_are_untracked(always_active):
+    # an all-zero descriptor (a sequence without a tracked frame) is no activity
+    zeros = np.zeros((200, 3))
+    assert not always_active.predict([zeros])[0].any()
+    assert not always_active.decision_function([zeros])[0].any()
+
+
+def test_segmenter_threshold_is_strict(segmenter):
+    # docs/method.md §4.4: active when the smoothed score EXCEEDS the threshold
+    seg = copy.deepcopy(segmenter).set_params(threshold=0.4, min_length=1)
+    assert not seg._periods(np.full(20, 0.4)).any()
+    assert seg._periods(np.full(20, np.nextafter(0.4, 1.0))).all()
+
+
+# --------------------------------------------------------------------------------
+# verbose, feature names, output containers (issue 9)
+# --------------------------------------------------------------------------------
+
+
+def test_segmenter_verbose_shows_the_network_progress(train, capsys):
+    X, y = train
+    ActivitySegmenter(_net(max_epochs=3), random_state=0).fit([X], [y])
+    assert capsys.readouterr() == ("", "")
+    ActivitySegmenter(_net(max_epochs=3), random_state=0, verbose=1).fit([X], [y])
+    assert "epoch" in capsys.readouterr().err  # a tqdm bar over epochs
+    ActivitySegmenter(_net(max_epochs=3), random_state=0, verbose=2).fit([X], [y])
+    lines = capsys.readouterr().out.splitlines()
+    assert "valid_loss" in lines[0]
+    assert [ln.split()[0] for ln in lines[2:5]] == ["1", "2", "3"]
+
+
+def test_segmenter_verbose_does_not_change_the_network(train, tmp_path):
+    X, y = train
+    quiet = ActivitySegmenter(_net(max_epochs=5), random_state=0).fit([X], [y])
+    loud = ActivitySegmenter(_net(max_epochs=5), random_state=0, verbose=2)
+    memory = joblib.Memory(tmp_path, verbose=0)
+    cached = ActivitySegmenter(_net(max_epochs=5), random_state=0, memory=memory)
+    cached.fit([X], [y])
+    loud.set_params(memory=memory).fit([X], [y])  # the cache ignores verbose
+    assert _n_cached(tmp_path) == 1
+    for key, value in _state(quiet).items():
+        assert torch.equal(value, _state(loud)[key])
+
+
+def test_segmenter_feature_names_pass_through(segmenter):
+    assert segmenter.get_feature_names_out().tolist() == ["x0", "x1", "x2"]
+    names = ["a", "b", "c"]
+    assert segmenter.get_feature_names_out(names).tolist() == names
+
+
+def test_segmenter_refuses_a_dataframe_output(segmenter, test_stream):
+    import sklearn
+
+    X, _ = test_stream
+    with pytest.raises(ValueError, match="list of per-sequence arrays"):
+        copy.deepcopy(segmenter).set_output(transform="pandas")
+    with sklearn.config_context(transform_output="pandas"):
+        out = segmenter.transform([X])  # the global setting leaves it alone
+    assert isinstance(out[0], np.ma.MaskedArray)

@@ -1,4 +1,4 @@
-"""MATLAB-style loess smoothing against the reference numbers of METHOD_SPEC §8.1."""
+"""MATLAB-style loess smoothing against the reference numbers of docs/method.md §8.1."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from skgesture.utils._smoothing import loess_kernel, loess_smooth
 
-# METHOD_SPEC §8.1, interior kernel table (5 decimals).
+# docs/method.md §8.1, interior kernel table (5 decimals).
 KERNELS_GT = {
     5: [0, 0, 1, 0, 0],
     7: [0, -0.07734, 0.30938, 0.53594, 0.30938, -0.07734, 0],
@@ -17,7 +17,7 @@ KERNELS_GT = {
          0.21040, 0.15681, 0.07435, -0.00400, -0.03575, -0.01525, 0],
 }  # fmt: skip
 
-# METHOD_SPEC §8.1 test vector and its smoothed versions (4 decimals).
+# docs/method.md §8.1 test vector and its smoothed versions (4 decimals).
 Y_GT = np.array(
     [0.10, 0.20, 0.90, 0.30, 0.80, 0.70, 0.95, 0.20, 0.10, 0.05, 0.60, 0.40]
 )
@@ -30,7 +30,7 @@ SMOOTHED_GT = {
         0.2049, 0.3016, 0.5185],
 }  # fmt: skip
 
-# METHOD_SPEC §11 item 5: short tracks with span 15.
+# docs/method.md §11 item 5: short tracks with span 15.
 SHORT_GT = [
     ([1, 3, 2, 5], [1.2410, 2.0897, 2.9103, 4.7590]),
     ([1, 3, 2, 5, 4], [1.2410, 2.0897, 2.0000, 3.9596, 4.2754]),
@@ -41,7 +41,7 @@ ATOL_5DP = 5e-6  # kernel table has 5 decimals
 
 
 def _reference_smooth(y, span, degree):
-    """Point-by-point weighted polyfit written straight from METHOD_SPEC §8.1."""
+    """Point-by-point weighted polyfit written straight from docs/method.md §8.1."""
     y = np.asarray(y, dtype=float)
     n = y.size
     h = (span - 1) // 2

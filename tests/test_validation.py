@@ -248,3 +248,89 @@ def test_remove_short_runs(min_length):
     out = remove_short_runs(labels, min_length)
     assert_array_equal(out, SHORT_RUNS_GT[min_length])
     assert_array_equal(labels, LABELS_GT)  # a copy
+
+
+# --------------------------------------------------------------------------------
+# Values: checked before the cast, bounded (docs/design.md, "Bad input")
+# --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "bad, kwargs, message",
+    [
+        # float32 would silently turn 1e39 into inf
+        (1e39, {"dtype": np.float32}, r"X\[1\] has the value 1e\+39 at frame 2"),
+        (-2e30, {}, r"X\[1\] has the value -2e\+30 at frame 2, beyond the accepted "
+         r"magnitude 1e\+30"),
+        (2e5, {"allow_nan": True, "max_abs": 1e5}, r"X\[1\] has the value 2e\+05"),
+        (np.inf, {"allow_nan": True}, r"X\[1\] contains infinite values \(first at "
+         r"frame 2\).*never inf"),
+        (np.nan, {}, r"X\[1\] contains NaN or infinite values \(first at frame 2\)"),
+    ],
+)  # fmt: skip
+def test_check_sequences_refuses_values_beyond_the_bound(bad, kwargs, message):
+    x = np.ones((4, 3))
+    x[2, 1] = bad
+    with pytest.raises(ValueError, match=message):
+        check_sequences([np.ones((2, 3)), x], **kwargs)
+
+
+def test_check_sequences_bound_is_inclusive_and_nan_passes_when_allowed():
+    x = np.full((3, 2), 1e30)
+    x[1] = np.nan
+    out = check_sequences([x], allow_nan=True, dtype=np.float32)[0]
+    assert out.dtype == np.float32 and np.isfinite(out[[0, 2]]).all()
+    assert np.isnan(check_sequences([np.full((2, 2), np.nan)], allow_nan=True)[0]).all()
+
+
+@pytest.mark.parametrize(
+    "X, message",
+    [
+        ([np.ones((2, 2), dtype=complex)], r"X\[0\] cannot be converted .* complex"),
+        (
+            [np.array([[1, 2], [3, 10**40]], dtype=object)],
+            r"X\[0\] has the value 1e\+40",
+        ),
+        ([[["1", "x"]]], r"X\[0\] cannot be converted"),
+    ],
+)
+def test_check_sequences_refuses_non_real_values(X, message):
+    with pytest.raises(ValueError, match=message):
+        check_sequences(X)
+
+
+def test_check_sequences_accepts_ints_bools_and_read_only_arrays():
+    x = np.arange(6).reshape(3, 2)
+    x.setflags(write=False)
+    assert check_sequences([x, np.ones((2, 2), dtype=bool)])[0].dtype == np.float64
+
+
+def test_sequence_of_constraint_checks_every_entry():
+    from sklearn.utils._param_validation import (
+        InvalidParameterError,
+        validate_parameter_constraints,
+    )
+
+    from skgesture.utils._validation import SequenceOf
+
+    steps = SequenceOf.ints(1)
+    assert steps.is_satisfied_by([4, np.int64(3)])
+    for bad in [(), (0,), (2.5,), (True,), "42", 4, None, np.array([4, 3])]:
+        assert not steps.is_satisfied_by(bad), bad
+    assert SequenceOf.ints(1, allow_empty=True).is_satisfied_by(())
+    weights = SequenceOf(lambda w: w >= 0, "weights", whole=sum, arrays=True)
+    assert weights.is_satisfied_by(np.array([0.0, 1.0]))
+    assert not weights.is_satisfied_by((0.0, 0.0))
+    with pytest.raises(InvalidParameterError, match="must be a non-empty tuple of"):
+        validate_parameter_constraints({"steps": [steps]}, {"steps": (2.5,)}, "f")
+
+
+def test_refuse_set_output_keeps_the_default_and_explains_the_rest():
+    from skgesture.utils._validation import refuse_set_output
+
+    est = BaseEstimator()
+    assert refuse_set_output(est, None) is est
+    assert refuse_set_output(est, "default") is est
+    for container in ("pandas", "polars"):
+        with pytest.raises(ValueError, match=f"set_output.transform='{container}'"):
+            refuse_set_output(est, container)

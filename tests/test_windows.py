@@ -1,9 +1,10 @@
-"""Dynamic poses (METHOD_SPEC §5.1-§5.3, §6.2): offsets, borders, masks and the
+"""Dynamic poses (docs/method.md §5.1-§5.3, §6.2): offsets, borders, masks and the
 windows of one period of activity (§11 item 8)."""
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.utils._param_validation import InvalidParameterError
 
 from skgesture import DynamicPoseWindow
 from skgesture._multiscale import period_windows
@@ -90,18 +91,78 @@ def test_dynamic_pose_window_plain_input_gives_plain_output():
     assert not isinstance(W, np.ma.MaskedArray)
 
 
+STEPS_ERROR = (
+    r"'steps' parameter of DynamicPoseWindow must be a non-empty tuple of ints"
+)
+
+
 @pytest.mark.parametrize(
-    "params, message",
+    "params, error, message",
     [
-        ({"steps": ()}, "non-empty"),
-        ({"steps": (4, 0)}, "positive"),
-        ({"steps": (4, "a")}, "steps"),
-        ({"n_poses": 2}, "n_poses must be odd"),
+        ({"steps": ()}, InvalidParameterError, STEPS_ERROR),
+        ({"steps": (4, 0)}, InvalidParameterError, STEPS_ERROR),
+        ({"steps": (4, "a")}, InvalidParameterError, STEPS_ERROR),
+        ({"steps": (2.5,)}, InvalidParameterError, STEPS_ERROR),  # not truncated
+        ({"steps": (4, True)}, InvalidParameterError, STEPS_ERROR),
+        ({"n_poses": 2}, ValueError, "n_poses must be odd"),
     ],
 )
-def test_dynamic_pose_window_rejects_bad_steps(params, message):
-    with pytest.raises(ValueError, match=message):
+def test_dynamic_pose_window_rejects_bad_steps(params, error, message):
+    with pytest.raises(error, match=message):
         DynamicPoseWindow(**params).fit([D_RAMP])
+
+
+def test_dynamic_pose_window_transform_rechecks_steps_changed_after_fit():
+    win = DynamicPoseWindow().fit([D_RAMP]).set_params(steps=(2.5,))
+    with pytest.raises(ValueError, match="steps must be a non-empty tuple"):
+        win.transform([D_RAMP])
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        (np.inf, r"X\[1\] contains NaN or infinite values \(first at frame 3\)"),
+        (np.nan, r"X\[1\] contains NaN or infinite values \(first at frame 3\)"),
+        # float32 would turn this into inf: refused before the cast
+        (1e39, r"X\[1\] has the value 1e\+39 at frame 3, beyond the accepted"),
+    ],
+)
+def test_dynamic_pose_window_refuses_values_float32_cannot_hold(bad, message):
+    win = DynamicPoseWindow().fit([D_RAMP])
+    X = D_RAMP.copy()
+    X[3, 1] = bad
+    for method in (win.transform, DynamicPoseWindow().fit):
+        with pytest.raises(ValueError, match=message):
+            method([D_RAMP, X])
+
+
+def test_dynamic_pose_window_masks_rows_with_any_masked_value():
+    mask = np.zeros(D_RAMP.shape, dtype=bool)
+    mask[2, 0] = True  # one masked value marks the row
+    W = DynamicPoseWindow().fit_transform([np.ma.MaskedArray(D_RAMP, mask=mask)])[0]
+    rows = np.arange(N_FRAMES) == 2
+    assert_array_equal(np.ma.getmaskarray(W).all(axis=(1, 2)), rows)
+    assert not np.ma.getmaskarray(W)[~rows].any()
+
+
+def test_dynamic_pose_window_feature_names_follow_the_output_layout():
+    D = np.arange(30, dtype=float).reshape(10, 3)
+    win = DynamicPoseWindow(steps=(4, 2)).fit([D])
+    names = win.get_feature_names_out(["a", "b", "c"]).reshape(2, 9)
+    W = win.transform([D])[0]
+    # frame 5, scale of step 2: the pose 2 frames before is descriptor frame 3
+    assert names[1, 0] == "step2_t-2_a" and W[5, 1, 0] == D[3, 0]
+    assert names[0, 8] == "step4_t+4_c" and W[5, 0, 8] == D[9, 2]
+    assert win.get_feature_names_out()[0] == "step4_t-4_x0"
+    with pytest.raises(ValueError, match="input_features"):
+        win.get_feature_names_out(["a", "b"])
+
+
+def test_dynamic_pose_window_refuses_a_dataframe_output():
+    win = DynamicPoseWindow()
+    assert win.set_output(transform="default") is win
+    with pytest.raises(ValueError, match="list of per-sequence arrays"):
+        win.set_output(transform="pandas")
 
 
 def test_dynamic_pose_window_transform_checks_width_seen_in_fit():

@@ -1,6 +1,6 @@
 """Shared helpers of the dataset loaders: file reading, table parsing, Bunch building.
 
-Every loader returns the same :class:`sklearn.utils.Bunch` (DESIGN §1 and §7):
+Every loader returns the same :class:`sklearn.utils.Bunch` (docs/design.md §1 and §7):
 ``X`` (list of ``(T_i, 20, 3)`` float64 world positions in metres, Kinect v1 NUI
 joint order), ``y`` (list of ``(T_i,)`` int64 per-frame labels, 0 = rest),
 ``segments`` (list of ``(n_i, 3)`` int64 rows ``(class, start, end)``, 0-based,

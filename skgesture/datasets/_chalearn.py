@@ -1,8 +1,8 @@
 """ChaLearn LAP 2014 Track 3 (Montalbano V2) reader and prediction writer.
 
 Also reads the ChaLearn 2013 (Montalbano V1) samples once converted to the same
-three CSV files. File formats: METHOD_SPEC §1.2-§1.7; the writer applies the
-clamping of METHOD_SPEC §2.2 so that the official scorer never silently drops or
+three CSV files. File formats: docs/method.md §1.2-§1.7; the writer applies the
+clamping of docs/method.md §2.2 so that the official scorer never silently drops or
 misfiles a prediction.
 """
 
@@ -42,19 +42,19 @@ __all__ = [
     "write_chalearn_predictions",
 ]
 
-# METHOD_SPEC §1.6: class id k (1-based) is CHALEARN_GESTURE_NAMES[k - 1].
+# docs/method.md §1.6: class id k (1-based) is CHALEARN_GESTURE_NAMES[k - 1].
 CHALEARN_GESTURE_NAMES = (
     "vattene", "vieniqui", "perfetto", "furbo", "cheduepalle",
     "chevuoi", "daccordo", "seipazzo", "combinato", "freganiente",
     "ok", "cosatifarei", "basta", "prendere", "noncenepiu",
     "fame", "tantotempo", "buonissimo", "messidaccordo", "sonostufo",
 )  # fmt: skip
-N_CHALEARN_CLASSES = len(CHALEARN_GESTURE_NAMES)  # METHOD_SPEC §1.6
-CHALEARN_FPS = 20.0  # METHOD_SPEC §1.3: every Montalbano sequence
-VALUES_PER_JOINT = 9  # Wx, Wy, Wz, 4 rotation, Px, Py (METHOD_SPEC §1.4)
+N_CHALEARN_CLASSES = len(CHALEARN_GESTURE_NAMES)  # docs/method.md §1.6
+CHALEARN_FPS = 20.0  # docs/method.md §1.3: every Montalbano sequence
+VALUES_PER_JOINT = 9  # Wx, Wy, Wz, 4 rotation, Px, Py (docs/method.md §1.4)
 N_SKELETON_COLUMNS = N_KINECT_JOINTS * VALUES_PER_JOINT  # 180
-N_LABEL_COLUMNS = 3  # class, start, end (METHOD_SPEC §1.5)
-N_DATA_COLUMNS = 3  # numFrames, fps, maxDepth (METHOD_SPEC §1.3)
+N_LABEL_COLUMNS = 3  # class, start, end (docs/method.md §1.5)
+N_DATA_COLUMNS = 3  # numFrames, fps, maxDepth (docs/method.md §1.3)
 # numFrames may differ from the skeleton's line count by this much (the skeleton
 # is then padded with missing frames or truncated, with a warning); beyond it the
 # two files disagree too much to trust either and loading stops. Every real
@@ -522,7 +522,7 @@ def load_chalearn(
     -----
     DataFileWarning
         When a skeleton has a few more or fewer lines than numFrames (truncated
-        or padded with missing frames, METHOD_SPEC §1.4), when labels overlap
+        or padded with missing frames, docs/method.md §1.4), when labels overlap
         (kept in ``segments``; in ``y`` the later gesture wins), or, labels
         only, when numFrames lies far beyond the last labelled frame.
 
@@ -685,7 +685,7 @@ def _as_prediction_segments(pred, sid, n_frames):
             f"{sid}: expected per-frame labels of shape (n_frames,) or segments of "
             f"shape (n, 3), got shape {arr.shape}"
         )
-    start = np.maximum(seg[:, 1] + 1, 1)  # 1-based, METHOD_SPEC §2.2 clamping
+    start = np.maximum(seg[:, 1] + 1, 1)  # 1-based, docs/method.md §2.2 clamping
     end = seg[:, 2] if n_frames is None else np.minimum(seg[:, 2], n_frames)
     outside = start > end
     if outside.any():
@@ -705,7 +705,7 @@ def write_chalearn_predictions(
 
     Each file has one ``class,start,end`` line per predicted gesture (1-based,
     inclusive frames, sorted by start); a sequence without any prediction gets
-    an empty file, as the official scorer expects (METHOD_SPEC §1.7).
+    an empty file, as the official scorer expects (docs/method.md §1.7).
 
     Parameters
     ----------
@@ -720,7 +720,8 @@ def write_chalearn_predictions(
         Output folder, created if needed.
     n_frames : int, list of int or None, default=None
         Number of frames (numFrames) of each sequence (e.g. ``data.n_frames``). Frames
-        are clamped to ``1 <= start <= end <= numFrames`` (METHOD_SPEC §2.2); without it
+        are clamped to ``1 <= start <= end <= numFrames`` (docs/method.md
+        §2.2); without it
         only ``start >= 1`` is enforced (and labels past it are dropped).
     overwrite : bool, default=False
         Replace prediction files that already exist in ``folder``. By default

@@ -1,7 +1,7 @@
 """Evaluation of per-frame gesture labellings.
 
 The ChaLearn LAP 2014 Jaccard index exactly as the official script computes it
-(with the penalised and inclusive variants of METHOD_SPEC §2.3), frame accuracy,
+(with the penalised and inclusive variants of docs/method.md §2.3), frame accuracy,
 the frame confusion matrix, the segmental F1@k and edit scores of temporal action
 segmentation, and scorers for ``GridSearchCV``.
 """

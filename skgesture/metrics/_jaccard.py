@@ -3,9 +3,9 @@
 One private function, :func:`_jaccard_from_lines`, holds the formula. It works on
 the lines of the label and prediction files (``class, start, end``, 1-based,
 end inclusive by the file format) and reproduces the official script's quirks
-(METHOD_SPEC §2.1-§2.2). :func:`jaccard_index_segments` exposes it for one
+(docs/method.md §2.1-§2.2). :func:`jaccard_index_segments` exposes it for one
 sequence given as lines; :func:`jaccard_index` turns per-frame labels into lines
-(one line per maximal run of a gesture label, METHOD_SPEC §1.7) and averages over
+(one line per maximal run of a gesture label, docs/method.md §1.7) and averages over
 sequences.
 """
 
@@ -18,12 +18,12 @@ import numpy as np
 from sklearn.exceptions import UndefinedMetricWarning
 
 from skgesture.metrics._segmental import REST, _check_label_pairs
-from skgesture.utils._segments import labels_to_segments
+from skgesture.utils._segments import check_segments, labels_to_segments
 
 __all__ = ["jaccard_index", "jaccard_index_segments"]
 
-N_OFFICIAL_CLASSES = 20  # METHOD_SPEC §2.1: the script's 20 x n frame matrices
-JACCARD_MODES = ("official_2014", "fp_penalised", "inclusive")  # METHOD_SPEC §2.3
+N_OFFICIAL_CLASSES = 20  # docs/method.md §2.1: the script's 20 x n frame matrices
+JACCARD_MODES = ("official_2014", "fp_penalised", "inclusive")  # docs/method.md §2.3
 
 
 def _check_mode(mode):
@@ -85,7 +85,7 @@ def _check_lines(lines, name, n_classes):
 
 
 def _jaccard_from_lines(gt, pred, n_frames, mode, n_rows):
-    """Score of one sequence from validated lines (METHOD_SPEC §2.1, §2.3).
+    """Score of one sequence from validated lines (docs/method.md §2.1, §2.3).
 
     Parameters
     ----------
@@ -109,19 +109,26 @@ def _jaccard_from_lines(gt, pred, n_frames, mode, n_rows):
     """
     # The official script slices [s - 1, e - 1): the labelled end frame is dropped.
     # Plain Python slicing reproduces its clipping and negative-start behaviour.
+    # Only the rows of the ground-truth classes are built, one at a time, so the
+    # memory is O(n_frames) whatever the class ids (the script's matrices have
+    # n_rows x n_frames cells; a class id of 1e9 would ask for 93 GiB).
     stop_shift = 0 if mode == "inclusive" else 1
-    frames = {}
-    for key, lines in (("gt", gt), ("pred", pred)):
-        mat = np.zeros((n_rows, n_frames), dtype=bool)
-        for c, s, e in lines.tolist():
-            mat[c - 1, s - 1 : e - stop_shift] = True
-        frames[key] = mat
+
+    def row_frames(lines, row):
+        """Frames of matrix row ``row``: class c is written in row c - 1, so
+        class 0 lands in row -1, the last one, as in the script."""
+        frames = np.zeros(n_frames, dtype=bool)
+        for c, s, e in lines[(lines[:, 0] - 1) % n_rows == row].tolist():
+            frames[s - 1 : e - stop_shift] = True
+        return frames
+
     gt_classes = np.unique(gt[:, 0])
     if gt_classes.size == 0:
         return float("nan"), []
     overlaps, degenerate = [], []
     for c in gt_classes.tolist():
-        g, p = frames["gt"][c - 1], frames["pred"][c - 1]
+        row = (c - 1) % n_rows
+        g, p = row_frames(gt, row), row_frames(pred, row)
         union = int(np.count_nonzero(g | p))
         if union == 0:
             degenerate.append(c)
@@ -132,7 +139,7 @@ def _jaccard_from_lines(gt, pred, n_frames, mode, n_rows):
     if mode == "fp_penalised":
         n_false_pos = np.setdiff1d(np.unique(pred[:, 0]), gt_classes).size
     # The script's own "false positives", setdiff(gt, union(gt, pred)), are always
-    # empty (METHOD_SPEC §2.1 step 5), so official and inclusive add nothing.
+    # empty (docs/method.md §2.1 step 5), so official and inclusive add nothing.
     return sum(overlaps) / (len(overlaps) + n_false_pos), degenerate
 
 
@@ -198,7 +205,7 @@ def jaccard_index_segments(
     written into row -1, i.e. shares the row of class ``n_classes``. Both are
     reproduced, with a ``UserWarning``. A ground-truth class with no frame left
     and not predicted (0/0 in the script) scores 0, with an
-    ``UndefinedMetricWarning`` (METHOD_SPEC §2.2).
+    ``UndefinedMetricWarning`` (docs/method.md §2.2).
 
     References
     ----------
@@ -207,7 +214,7 @@ def jaccard_index_segments(
 
     Examples
     --------
-    The worked example of METHOD_SPEC §2.4 (10 frames):
+    The worked example of docs/method.md §2.4 (10 frames):
 
     >>> from skgesture.metrics import jaccard_index_segments
     >>> gt = [[3, 2, 6], [5, 7, 10]]
@@ -250,14 +257,42 @@ def _labels_to_lines(y):
     return seg
 
 
+def _true_segment_lines(true_segments, y_true):
+    """File lines (1-based start, end inclusive) of ``true_segments``, or None."""
+    if true_segments is None:
+        return None
+    if isinstance(true_segments, (str, bytes)) or not hasattr(true_segments, "__len__"):
+        raise TypeError(
+            f"true_segments must be a list of (n_i, 3) segment arrays, one per "
+            f"sequence, got {type(true_segments).__name__}"
+        )
+    if len(true_segments) != len(y_true):
+        raise ValueError(
+            f"true_segments has {len(true_segments)} sequences but y_true has "
+            f"{len(y_true)}: give one segment array per sequence"
+        )
+    lines = []
+    for i, (seg, yt) in enumerate(zip(true_segments, y_true)):
+        seg = check_segments(seg, len(yt), name=f"true_segments[{i}]")
+        seg[:, 1] += 1  # 0-based start -> 1-based; the exclusive end is the last
+        lines.append(seg)
+    return lines
+
+
 def jaccard_index(
-    y_true, y_pred, *, mode="official_2014", per_sequence=False, n_classes=None
+    y_true,
+    y_pred,
+    *,
+    mode="official_2014",
+    per_sequence=False,
+    n_classes=None,
+    true_segments=None,
 ):
     """Mean ChaLearn LAP 2014 Jaccard index over sequences of per-frame labels.
 
     Every maximal run of one gesture label, frames ``s .. e`` (1-based,
     inclusive), becomes the file line ``c, s, e`` that the challenge's writer
-    produces (METHOD_SPEC §1.7), for the ground truth and the prediction alike.
+    produces (docs/method.md §1.7), for the ground truth and the prediction alike.
     Each sequence is then scored by :func:`jaccard_index_segments`, and the
     scores are averaged with equal weight per sequence, as the official script
     does. In the official mode the last frame of every run is therefore not
@@ -279,6 +314,14 @@ def jaccard_index(
     n_classes : int, default=None
         Largest valid class id; a larger label raises a ``ValueError``. ``None``
         accepts any label (the scores do not depend on it).
+    true_segments : list of array-like of shape (n_gestures_i, 3) or None, \
+            default=None
+        The ground-truth instances as the label files list them, rows
+        ``(class, start, end)``, 0-based, ``end`` exclusive (the ``segments``
+        of every loader's Bunch). When given, they are scored instead of the
+        runs of ``y_true`` (which still gives the sequence lengths): this is
+        the official score exactly, also where two instances of one class
+        touch (see Notes). ``None``: the runs of ``y_true``.
 
     Returns
     -------
@@ -299,12 +342,23 @@ def jaccard_index(
 
     Notes
     -----
+    **Where this differs from the official score.** Per-frame labels cannot say
+    where one instance ends and the next begins when two instances of one class
+    touch: their frames form one run, hence one line, and only the last frame of
+    the merged run is dropped instead of the last frame of each instance. With
+    ground-truth lines ``3,11,40`` and ``3,41,70`` and the prediction
+    ``3,11,70``, the official script gives 58/59 = 0.98305, the per-frame
+    version 1.0 (docs/method.md §2.2). Elsewhere the two agree. The
+    estimators' ``score`` and the scorers use the per-frame version; to score
+    against label files, pass their instances as ``true_segments`` (or score
+    the lines with :func:`jaccard_index_segments`).
+
     A sequence without any ground-truth gesture is undefined (the official script
     divides by zero): it is skipped with an ``UndefinedMetricWarning``. If every
     sequence is skipped the result is NaN, with a second warning. Within a
     sequence a ground-truth class with no frame left after the end-frame
     exclusion (a 1-frame run) and not predicted scores 0, with a warning.
-    Evaluation choice D19 of METHOD_SPEC: report ``"official_2014"`` as the
+    Evaluation choice D19 of docs/method.md: report ``"official_2014"`` as the
     headline, ``"fp_penalised"`` and ``"inclusive"`` beside it.
 
     References
@@ -323,20 +377,32 @@ def jaccard_index(
     0.25
     >>> jaccard_index(y_true + y_true, [y_true[0], y_pred[0]], per_sequence=True)
     array([1.   , 0.375])
+
+    Two touching instances of class 3 (frames 10-39 and 40-69, 0-based):
+
+    >>> import numpy as np
+    >>> y = np.zeros(80, int); y[10:70] = 3
+    >>> jaccard_index([y], [y])
+    1.0
+    >>> round(jaccard_index([y], [y], true_segments=[[[3, 10, 40], [3, 40, 70]]]), 5)
+    0.98305
     """
     _check_mode(mode)
     if n_classes is not None:
         n_classes = _check_positive_int(n_classes, "n_classes")
     y_true, y_pred = _check_label_pairs(y_true, y_pred, n_classes=n_classes)
+    gt_lines = _true_segment_lines(true_segments, y_true)
     if n_classes is None:
         largest = max((int(y.max()) for y in y_true + y_pred if y.size), default=0)
+        for g in gt_lines or []:
+            largest = max(largest, int(g[:, 0].max()) if len(g) else 0)
         n_rows = max(N_OFFICIAL_CLASSES, largest)
     else:
         n_rows = n_classes
     scores = np.full(len(y_true), np.nan)
     skipped = []
     for i, (yt, yp) in enumerate(zip(y_true, y_pred)):
-        gt = _labels_to_lines(yt)
+        gt = _labels_to_lines(yt) if gt_lines is None else gt_lines[i]
         if not len(gt):
             skipped.append(i)
             continue

@@ -25,7 +25,7 @@ __all__ = [
     "edit_score",
 ]
 
-REST = 0  # DESIGN §1: label 0 is rest / background
+REST = 0  # docs/design.md §1: label 0 is rest / background
 EDIT_SCALE = 100.0  # MS-TCN reports the edit score in percent
 
 

@@ -11,9 +11,9 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 __all__ = ["resize_frames", "imresize_weights"]
 
-KEYS_A = -0.5  # METHOD_SPEC §8.5: Keys cubic convolution parameter of imresize
-KEYS_WIDTH = 4.0  # METHOD_SPEC §8.5: the bicubic kernel covers 4 input samples
-_METHODS = ("bicubic", "pchip", "spline")  # METHOD_SPEC §8.5, decision D15
+KEYS_A = -0.5  # docs/method.md §8.5: Keys cubic convolution parameter of imresize
+KEYS_WIDTH = 4.0  # docs/method.md §8.5: the bicubic kernel covers 4 input samples
+_METHODS = ("bicubic", "pchip", "spline")  # docs/method.md §8.5, decision D15
 
 
 def _keys_cubic(x):
@@ -81,7 +81,7 @@ def imresize_weights(n_in, n_out, *, antialiasing=True):
 
     Notes
     -----
-    METHOD_SPEC §8.5: output sample ``i`` (1-based) sits at input coordinate
+    docs/method.md §8.5: output sample ``i`` (1-based) sits at input coordinate
     ``u = i / s + 0.5 (1 - 1 / s)`` with ``s = m / L``; it takes Keys-cubic
     weights ``k(u - j)`` (``a = -0.5``) of the 4 nearest input samples,
     normalised to sum 1, with out-of-range samples mirrored symmetrically
@@ -137,7 +137,7 @@ def resize_frames(x, n_out, *, method="bicubic"):
 
     Notes
     -----
-    METHOD_SPEC §8.5 and decision D15 (default bicubic). ``"bicubic"`` and
+    docs/method.md §8.5 and decision D15 (default bicubic). ``"bicubic"`` and
     ``"spline"`` are linear maps, applied as one ``(n_out, L)`` matrix
     product; ``"pchip"`` is not linear and calls
     :class:`scipy.interpolate.PchipInterpolator` on all columns at once.

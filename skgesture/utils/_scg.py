@@ -10,11 +10,11 @@ from torch.optim import Optimizer
 
 __all__ = ["SCG"]
 
-SCG_SIGMA = 5.0e-5  # METHOD_SPEC §8.6.1: finite-difference step of trainscg
-SCG_LAMBDA = 5.0e-7  # METHOD_SPEC §8.6.1: initial scale parameter of trainscg
-GOOD_REDUCTION = 0.75  # METHOD_SPEC §8.6.2: Δ >= 0.75 -> λ shrinks
-LAMBDA_SHRINK = 0.25  # METHOD_SPEC §8.6.2: λ <- λ / 4
-POOR_REDUCTION = 0.25  # METHOD_SPEC §8.6.2: Δ < 0.25 -> λ grows
+SCG_SIGMA = 5.0e-5  # docs/method.md §8.6.1: finite-difference step of trainscg
+SCG_LAMBDA = 5.0e-7  # docs/method.md §8.6.1: initial scale parameter of trainscg
+GOOD_REDUCTION = 0.75  # docs/method.md §8.6.2: Δ >= 0.75 -> λ shrinks
+LAMBDA_SHRINK = 0.25  # docs/method.md §8.6.2: λ <- λ / 4
+POOR_REDUCTION = 0.25  # docs/method.md §8.6.2: Δ < 0.25 -> λ grows
 
 _INFO_KEYS = (
     "n_iter",
@@ -98,7 +98,7 @@ class SCG(Optimizer):
 
     Notes
     -----
-    Implements the pseudo-code of METHOD_SPEC §8.6.2 (MATLAB ``trainscg``,
+    Implements the pseudo-code of docs/method.md §8.6.2 (MATLAB ``trainscg``,
     σ and λ defaults of §8.6.1), with ``g = ∇E(w)``, ``p`` the direction:
     ``s = (∇E(w + σk p) - g) / σk`` with ``σk = σ / ‖p‖`` (only after a
     success), ``δ = pᵀs + (λ - λ̄)‖p‖²`` (made positive if needed),

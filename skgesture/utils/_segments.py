@@ -8,11 +8,111 @@ the writer convert (``start + 1``, ``end``).
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import numbers
 import warnings
 
 import numpy as np
 
-__all__ = ["labels_to_segments", "segments_to_labels", "runs", "remove_short_runs"]
+__all__ = [
+    "labels_to_segments",
+    "segments_to_labels",
+    "check_segments",
+    "runs",
+    "remove_short_runs",
+]
+
+
+def _integral(arr):
+    """Mask of the entries of a numeric array that are whole numbers."""
+    if np.issubdtype(arr.dtype, np.integer) or arr.dtype == bool:
+        return np.ones(arr.shape, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(arr) & (arr == np.round(arr))
+
+
+def _as_numbers(values, name):
+    arr = np.asarray(values)
+    if (
+        arr.dtype == object
+        or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool)
+        or np.iscomplexobj(arr)
+    ):
+        raise ValueError(f"{name} must hold integers, got dtype {arr.dtype}")
+    return arr
+
+
+def _check_n_frames(n_frames):
+    if (
+        not isinstance(n_frames, numbers.Integral)
+        or isinstance(n_frames, bool)
+        or n_frames < 0
+    ):
+        raise ValueError(f"n_frames must be a non-negative integer, got {n_frames!r}")
+    return int(n_frames)
+
+
+def check_segments(segments, n_frames, *, name="segments"):
+    """Validate segments ``(class, start, end)`` of a sequence of ``n_frames``.
+
+    Parameters
+    ----------
+    segments : array-like of shape (n_segments, 3)
+        Rows ``(class, start, end)``, 0-based, ``end`` exclusive; floats are
+        accepted when they are whole numbers.
+    n_frames : int
+        Length of the sequence.
+    name : str, default="segments"
+        Name used in error messages.
+
+    Returns
+    -------
+    ndarray of int64 of shape (n_segments, 3)
+        A validated copy.
+
+    Raises
+    ------
+    ValueError
+        Naming the row, for a shape other than ``(n, 3)``, a value that is not
+        a whole number, a class below 1 or bounds outside
+        ``0 <= start < end <= n_frames``.
+
+    Examples
+    --------
+    >>> from skgesture.utils._segments import check_segments
+    >>> check_segments([[3, 1.0, 3]], 8).tolist()
+    [[3, 1, 3]]
+    """
+    n_frames = _check_n_frames(n_frames)
+    arr = _as_numbers(segments, name)
+    if arr.size == 0:
+        return np.zeros((0, 3), dtype=np.int64)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(
+            f"{name} must have shape (n_segments, 3) with rows (class, start, end); "
+            f"got shape {arr.shape}"
+        )
+    whole = _integral(arr).all(axis=1)
+    if not whole.all():
+        row = int(np.argmin(whole))
+        raise ValueError(
+            f"{name} row {row} = {tuple(arr[row].tolist())} holds a value that is "
+            f"not a whole number (class, start and end are integers)"
+        )
+    if np.abs(arr).max() > np.iinfo(np.int64).max:
+        row = int(np.argmax(np.abs(arr).max(axis=1)))
+        raise ValueError(f"{name} row {row} = {tuple(arr[row].tolist())} overflows")
+    seg = arr.astype(np.int64)
+    for row, (c, s, e) in enumerate(seg.tolist()):
+        if c < 1:
+            raise ValueError(
+                f"{name} row {row} has class {c}; gesture classes are >= 1"
+            )
+        if s < 0 or e > n_frames or s >= e:
+            raise ValueError(
+                f"{name} row {row} = ({c}, {s}, {e}) is outside 0 <= start < end <= "
+                f"{n_frames}"
+            )
+    return seg
 
 
 def runs(values):
@@ -61,13 +161,28 @@ def labels_to_segments(y, *, rest=0):
     ndarray of shape (n_segments, 3)
         Rows ``(class, start, end)``, 0-based, ``end`` exclusive, sorted by start.
 
+    Raises
+    ------
+    ValueError
+        If ``y`` is not 1-D or holds a value that is not a whole number (NaN,
+        1.7), naming the frame.
+
     Examples
     --------
     >>> from skgesture.metrics import labels_to_segments
     >>> labels_to_segments([0, 3, 3, 0, 5, 5, 5]).tolist()
     [[3, 1, 3], [5, 4, 7]]
     """
-    starts, ends, vals = runs(np.asarray(y).astype(np.int64))
+    arr = _as_numbers(y, "y")
+    if arr.ndim != 1:
+        raise ValueError(f"y must be 1-D (one label per frame), got shape {arr.shape}")
+    whole = _integral(arr)
+    if not whole.all():
+        frame = int(np.argmin(whole))
+        raise ValueError(
+            f"y must hold integer class labels: frame {frame} has {arr[frame]!r}"
+        )
+    starts, ends, vals = runs(arr.astype(np.int64))
     keep = vals != rest
     return np.stack([vals[keep], starts[keep], ends[keep]], axis=1).reshape(-1, 3)
 
@@ -90,6 +205,14 @@ def segments_to_labels(segments, n_frames, *, on_overlap="raise"):
     ndarray of shape (n_frames,)
         Per-frame labels, 0 outside every segment.
 
+    Raises
+    ------
+    ValueError
+        For a negative or non-integer ``n_frames``, or a bad row (see
+        :func:`check_segments`): a shape other than ``(n, 3)``, a bound that is
+        not a whole number, a class below 1, bounds outside
+        ``0 <= start < end <= n_frames``, or (``on_overlap="raise"``) an overlap.
+
     Examples
     --------
     >>> from skgesture.metrics import segments_to_labels
@@ -100,17 +223,10 @@ def segments_to_labels(segments, n_frames, *, on_overlap="raise"):
         raise ValueError(
             f"on_overlap must be 'raise', 'warn' or 'later', got {on_overlap!r}"
         )
-    seg = np.asarray(segments, dtype=np.int64).reshape(-1, 3)
+    seg = check_segments(segments, n_frames, name="segments")
     y = np.zeros(int(n_frames), dtype=np.int64)
     claimed = np.zeros(int(n_frames), dtype=bool)
-    for row, (c, s, e) in enumerate(seg):
-        if c < 1:
-            raise ValueError(f"segment {row} has class {c}; gesture classes are >= 1")
-        if s < 0 or e > n_frames or s >= e:
-            raise ValueError(
-                f"segment {row} = ({c}, {s}, {e}) is outside 0 <= start < end <= "
-                f"{n_frames}"
-            )
+    for row, (c, s, e) in enumerate(seg.tolist()):
         if claimed[s:e].any():
             frame = s + int(np.argmax(claimed[s:e]))
             msg = (

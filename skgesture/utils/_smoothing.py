@@ -10,8 +10,8 @@ import numpy as np
 
 __all__ = ["loess_smooth", "loess_kernel"]
 
-DEFAULT_SPAN = 5  # METHOD_SPEC §8.1 (MATLAB smooth default)
-_DEGREES = {"loess": 2, "lowess": 1}  # METHOD_SPEC §8.1 step 2
+DEFAULT_SPAN = 5  # docs/method.md §8.1 (MATLAB smooth default)
+_DEGREES = {"loess": 2, "lowess": 1}  # docs/method.md §8.1 step 2
 
 
 def _check_method(method):
@@ -23,7 +23,7 @@ def _check_method(method):
 def _effective_span(span, n):
     """Span actually used by MATLAB ``smooth`` for ``n`` uniform points.
 
-    Follows METHOD_SPEC §8.1 step 1 and §8.4: a fraction ``0 < span < 1``
+    Follows docs/method.md §8.1 step 1 and §8.4: a fraction ``0 < span < 1``
     becomes ``ceil(span * n)``; the span is floored, capped at ``n`` and, when
     it is not 1, forced odd (so it may become ``n + 1`` for even ``n``).
     """
@@ -73,14 +73,14 @@ def _loess_weights(span, degree):
     ``span`` must be odd and >= 3. Cached; the returned arrays are read-only.
     """
     h = (span - 1) // 2
-    # Interior (METHOD_SPEC §8.1 step 2): offsets -(h-1)..(h-1), the two
+    # Interior (docs/method.md §8.1 step 2): offsets -(h-1)..(h-1), the two
     # extreme points of the span have zero tricube weight.
     offsets = np.arange(-(h - 1), h, dtype=np.float64)
     base = 1.0 - (np.abs(offsets) / h) ** 3
     inner = _weighted_projection_row(offsets, h - 1, base, degree)
     kernel = np.zeros(span)
     kernel[1:-1] = inner
-    # End points (METHOD_SPEC §8.1 step 3): the first span - 1 points.
+    # End points (docs/method.md §8.1 step 3): the first span - 1 points.
     x = np.arange(1, span, dtype=np.float64)
     ends = np.empty((h, span - 1))
     for j in range(1, h + 1):
@@ -118,7 +118,7 @@ def loess_kernel(span=DEFAULT_SPAN, *, method="loess"):
 
     Notes
     -----
-    METHOD_SPEC §8.1 step 2 and its kernel table. With the MATLAB default
+    docs/method.md §8.1 step 2 and its kernel table. With the MATLAB default
     span 5 the loess kernel is ``(0, 0, 1, 0, 0)``: interior values are
     returned unchanged.
 
@@ -169,14 +169,14 @@ def loess_smooth(y, span=DEFAULT_SPAN, *, axis=0, method="loess"):
 
     Notes
     -----
-    Implements METHOD_SPEC §8.1 (uniform ``x``): tricube-weighted least
+    Implements docs/method.md §8.1 (uniform ``x``): tricube-weighted least
     squares, interior points through a fixed FIR kernel, end points
     ``j = 1..h`` through fits on the first (mirrored for the last) ``span - 1``
     points. When ``span`` exceeds an even ``n`` it becomes ``n + 1`` and every
     point is an end point. The robust variant ``'rloess'`` and MATLAB's NaN
     handling (removal and non-uniform refit) are not implemented: NaN values
     propagate to every output that uses them. This is not Savitzky-Golay
-    (METHOD_SPEC §8.2).
+    (docs/method.md §8.2).
 
     Examples
     --------

@@ -10,13 +10,24 @@ the frame and the expected shape, so a user can find the bad recording.
 import numbers
 
 import numpy as np
+from sklearn.utils._param_validation import Options
 
 __all__ = [
     "check_sequences",
     "check_sequence_labels",
     "missing_frames",
     "untracked_rows",
+    "SequenceOf",
+    "MAX_ABS_VALUE",
+    "MAX_COORDINATE",
 ]
+
+# The bounds of docs/design.md §1.2 (bad input). Features, windows and network inputs
+# stay far inside float32 (3.4e38), so no stage can overflow when it casts them;
+# raw skeleton coordinates are metres (or millimetres), so 1e5 is absurd in any
+# unit while the descriptor's squared norms stay exact in float64.
+MAX_ABS_VALUE = 1e30
+MAX_COORDINATE = 1e5
 
 
 def _describe(obj):
@@ -36,6 +47,7 @@ def check_sequences(
     reset=True,
     dtype=np.float64,
     name="X",
+    max_abs=MAX_ABS_VALUE,
 ):
     """Validate a list of sequences and return it as a list of float arrays.
 
@@ -62,11 +74,18 @@ def check_sequences(
         Output dtype.
     name : str, default="X"
         Name used in error messages.
+    max_abs : float, default=1e30
+        Largest magnitude accepted (``MAX_ABS_VALUE``; ``PoseDescriptor`` passes
+        ``MAX_COORDINATE`` = 1e5 for raw coordinates). Values are checked
+        before the cast to ``dtype``, so nothing overflows to ``inf`` silently
+        (docs/design.md §1.2).
 
     Returns
     -------
     list of ndarray
-        Validated, C-contiguous copies (or views) of the sequences.
+        Validated, C-contiguous copies (or views) of the sequences. The data
+        of a ``numpy.ma.MaskedArray`` is validated and returned (its mask is
+        not); read :func:`untracked_rows` first to keep it.
 
     Examples
     --------
@@ -90,12 +109,7 @@ def check_sequences(
     for i, seq in enumerate(X):
         if isinstance(seq, np.ma.MaskedArray):
             seq = seq.data
-        try:
-            arr = np.asarray(seq, dtype=dtype)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(
-                f"{name}[{i}] cannot be converted to a numeric array: {exc}"
-            ) from None
+        arr = _as_real_array(seq, f"{name}[{i}]")
         if arr.ndim < 2:
             raise ValueError(
                 f"{name}[{i}] has shape {arr.shape}; expected (n_frames, ...) with "
@@ -129,20 +143,8 @@ def check_sequences(
                 f"{name}[{i}] has {arr.shape[0]} frames; at least {min_frames} "
                 f"are required"
             )
-        if not allow_nan:
-            bad = ~np.isfinite(arr.reshape(arr.shape[0], -1))
-            if bad.any():
-                frame = int(np.flatnonzero(bad.any(axis=1))[0])
-                raise ValueError(
-                    f"{name}[{i}] contains NaN or infinite values (first at frame "
-                    f"{frame}); fill untracked frames first (PoseDescriptor does)"
-                )
-        elif np.isinf(arr).any():
-            frame = int(
-                np.flatnonzero(np.isinf(arr.reshape(arr.shape[0], -1)).any(1))[0]
-            )
-            raise ValueError(f"{name}[{i}] contains infinite values (frame {frame})")
-        out.append(np.ascontiguousarray(arr))
+        _check_values(arr, f"{name}[{i}]", allow_nan, max_abs)
+        out.append(np.ascontiguousarray(arr, dtype=dtype))
     if estimator is not None and reset:
         estimator.frame_shape_in_ = tuple(out[0].shape[1:])
         estimator.n_features_in_ = int(np.prod(out[0].shape[1:]))
@@ -153,6 +155,66 @@ def check_sequences(
                     f"has {estimator.frame_shape_in_}: all sequences must agree"
                 )
     return out
+
+
+def _as_real_array(seq, where):
+    """``seq`` as a floating ndarray (bool and int become float64), not yet cast."""
+    try:
+        arr = np.asarray(seq)
+        if arr.dtype.kind == "c":
+            raise TypeError(f"complex values (dtype {arr.dtype}) are not real")
+        if arr.dtype.kind != "f":
+            arr = np.asarray(seq, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"{where} cannot be converted to a numeric array: {exc}"
+        ) from None
+    return arr
+
+
+def _check_values(arr, where, allow_nan, max_abs):
+    """Raise a ValueError naming the frame of the first non-finite or absurd value.
+
+    The common case costs two reductions and no temporary array: the minimum and
+    the maximum are NaN if a NaN is present (``fmin``/``fmax`` skip NaN when NaN
+    is allowed), infinite if an inf is, and beyond ``max_abs`` if any value is.
+    The offending frame is only looked for on error.
+    """
+    if arr.size == 0:
+        return
+    lo_fn, hi_fn = (np.fmin, np.fmax) if allow_nan else (np.minimum, np.maximum)
+    lo, hi = float(lo_fn.reduce(arr, axis=None)), float(hi_fn.reduce(arr, axis=None))
+    if allow_nan and np.isnan(hi):
+        return  # every value is NaN: an untracked sequence
+    if -max_abs <= lo and hi <= max_abs:
+        return
+    flat = arr.reshape(arr.shape[0], -1)
+    with np.errstate(invalid="ignore"):
+        ok = np.abs(flat) <= max_abs
+    if allow_nan:
+        ok |= np.isnan(flat)
+    frame, col = (int(v[0]) for v in np.nonzero(~ok))
+    value = float(flat[frame, col])
+    if not np.isfinite(value):
+        if allow_nan:
+            what, hint = "infinite", "untracked frames are NaN or all zeros, never inf"
+        else:
+            what, hint = (
+                "NaN or infinite",
+                (
+                    "inputs must be finite: untracked frames are NaN only in raw "
+                    "skeletons, which PoseDescriptor fills (and masks)"
+                ),
+            )
+        raise ValueError(
+            f"{where} contains {what} values (first at frame {frame}), e.g. "
+            f"{value}; {hint}"
+        )
+    raise ValueError(
+        f"{where} has the value {value:.4g} at frame {frame}, beyond the accepted "
+        f"magnitude {max_abs:.0e} (docs/design.md §1.2): check the units "
+        f"and the recording"
+    )
 
 
 def check_sequence_labels(y, X=None, *, n_classes=None, name="y"):
@@ -294,3 +356,153 @@ def check_positive_int(value, name):
     if not isinstance(value, numbers.Integral) or value < 1:
         raise ValueError(f"{name} must be a positive integer, got {value!r}")
     return int(value)
+
+
+def _is_int(value, low):
+    return (
+        isinstance(value, numbers.Integral)
+        and not isinstance(value, bool)
+        and value >= low
+    )
+
+
+class SequenceOf(Options):
+    """Parameter constraint: a tuple or list whose every item passes ``item``.
+
+    For ``_parameter_constraints``, so a bad entry of a tuple parameter (a step
+    of 2.5, a layer of width 0, an unknown activation) raises sklearn's
+    ``InvalidParameterError`` naming the parameter, like any other constraint.
+    It subclasses :class:`~sklearn.utils._param_validation.Options` only to be
+    accepted by sklearn's ``make_constraint``.
+
+    Parameters
+    ----------
+    item : callable
+        ``item(value) -> bool`` for one entry.
+    description : str
+        What a valid value is, completing "must be ...".
+    allow_empty : bool, default=False
+        Whether an empty sequence is valid.
+    whole : callable or None, default=None
+        ``whole(values) -> bool``, a condition on the entries together.
+    arrays : bool, default=False
+        Whether a 1-D ndarray is accepted as well as a tuple or list.
+
+    Examples
+    --------
+    >>> from skgesture.utils._validation import SequenceOf
+    >>> steps = SequenceOf.ints(low=1)
+    >>> steps.is_satisfied_by((4, 3, 2)), steps.is_satisfied_by((2.5,))
+    (True, False)
+    >>> str(steps)
+    'a non-empty tuple of ints >= 1'
+    """
+
+    def __init__(self, item, description, *, allow_empty=False, whole=None,
+                 arrays=False):  # fmt: skip
+        super().__init__(type=object, options=set())
+        self.item = item
+        self.description = description
+        self.allow_empty = allow_empty
+        self.whole = whole
+        self.arrays = arrays
+
+    @classmethod
+    def ints(cls, low=1, *, allow_empty=False):
+        """Tuples of ints ``>= low``."""
+        size = "a tuple" if allow_empty else "a non-empty tuple"
+        return cls(
+            lambda v: _is_int(v, low),
+            f"{size} of ints >= {low}",
+            allow_empty=allow_empty,
+        )
+
+    def is_satisfied_by(self, val):
+        if self.arrays and isinstance(val, np.ndarray) and val.ndim == 1:
+            val = val.tolist()
+        if not isinstance(val, (tuple, list)):
+            return False
+        if not val and not self.allow_empty:
+            return False
+        if not all(self.item(v) for v in val):
+            return False
+        return self.whole is None or bool(self.whole(val))
+
+    def __str__(self):
+        return self.description
+
+
+def refuse_set_output(estimator, transform):
+    """``set_output`` of a sequence stage: only the default container exists.
+
+    The stages of skgesture return lists of per-sequence arrays (masked where
+    frames are rest), which no DataFrame holds; sklearn's automatic output
+    wrapping is off for them, so a global ``transform_output`` setting leaves
+    them unchanged, and an explicit request is refused here.
+    """
+    if transform is None or transform == "default":
+        return estimator
+    name = type(estimator).__name__
+    raise ValueError(
+        f"{name}.set_output(transform={transform!r}) is not supported: {name} "
+        f"returns a list of per-sequence arrays (one per recording), which has no "
+        f"{transform!r} form. Keep transform='default' and wrap one sequence "
+        f"yourself, e.g. pandas.DataFrame(Xt[i], "
+        f"columns=stage.get_feature_names_out())"
+    )
+
+
+def check_skeletons(X, *, estimator=None, reset=True, name="X"):
+    """Validate raw Kinect v1 skeleton sequences ``(n_frames_i, 20, 3)``.
+
+    The input rule of every stage that reads raw skeletons: a masked value of a
+    ``numpy.ma.MaskedArray`` marks an untracked joint and becomes NaN (so its
+    frame is untracked whatever lies under the mask); NaN is allowed; every
+    other value must be finite and at most ``MAX_COORDINATE`` in magnitude.
+
+    Parameters
+    ----------
+    X : list of array-like of shape (n_frames_i, 20, 3)
+        Skeleton sequences.
+    estimator : estimator or None, default=None
+        Passed to :func:`check_sequences` (``frame_shape_in_`` and
+        ``n_features_in_`` are set or checked).
+    reset : bool, default=True
+        Whether this call is a ``fit``.
+    name : str, default="X"
+        Name used in error messages.
+
+    Returns
+    -------
+    list of ndarray of shape (n_frames_i, 20, 3)
+        float64 copies, NaN where a joint is untracked.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.utils._validation import check_skeletons
+    >>> seq = np.ma.masked_array(np.ones((2, 20, 3)))
+    >>> seq[1, 4] = np.ma.masked
+    >>> out = check_skeletons([seq])
+    >>> bool(np.isnan(out[0][1, 4]).all()), bool(np.isnan(out[0][0]).any())
+    (True, False)
+    """
+    from skgesture.layouts import KINECT_V1, N_COORDS
+
+    if isinstance(X, (list, tuple)):
+        X = [
+            np.ma.filled(np.ma.asarray(seq, dtype=float), np.nan)
+            if isinstance(seq, np.ma.MaskedArray)
+            else seq
+            for seq in X
+        ]
+    return check_sequences(
+        X,
+        frame_shape=(KINECT_V1.n_joints, N_COORDS),
+        ndim=3,
+        allow_nan=True,
+        estimator=estimator,
+        reset=reset,
+        max_abs=MAX_COORDINATE,
+        name=name,
+    )
