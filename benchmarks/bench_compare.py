@@ -21,7 +21,7 @@ Usage::
 
     python benchmarks/bench_compare.py [--quick] [--methods M,...]
         [--datasets precog,synthetic] [--joints full20,paper11] [--seeds 0,1,2]
-        [--no-compute] [--list]
+        [--no-compute] [--cache-dir DIR] [--list]
 """
 
 import argparse
@@ -516,8 +516,17 @@ def main(argv=None):
     parser.add_argument(
         "--no-compute", action="store_true", help="print only what is cached"
     )
+    parser.add_argument(
+        "--cache-dir",
+        default=None,
+        help="where results are kept (default bench_results/compare); a new folder "
+        "recomputes everything, e.g. to time fits side by side on a quiet machine",
+    )
     parser.add_argument("--list", action="store_true", help="list the methods")
     args = parser.parse_args(argv)
+    if args.cache_dir is not None:
+        global CACHE_DIR
+        CACHE_DIR = Path(args.cache_dir)
     if args.list:
         for name, m in REGISTRY.items():
             print(f"{name} ({m.family}){'  *' if name in DEFAULT_METHODS else ''}")

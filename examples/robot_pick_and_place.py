@@ -273,7 +273,7 @@ def plot_timeline(path, commander, truth, states, target_names):
     ax.set_xlabel(f"frame ({FPS} fps)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
+    # left open: the documentation's gallery shows the figures still open
 
 
 def main():

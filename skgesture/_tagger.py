@@ -790,9 +790,9 @@ class SequenceTagger(_BaseTagger):
         Labels seen in ``fit``, rest (0) first.
     net_ : skorch.NeuralNet
         The trained network (``net_.history`` holds the losses).
-    mean_ : ndarray of shape (n_features_in_,)
+    mean_ : ndarray of shape (n_features,)
         Training mean of every feature.
-    scale_ : ndarray of shape (n_features_in_,)
+    scale_ : ndarray of shape (n_features,)
         Training standard deviation of every feature.
     n_features_in_ : int
         Number of features per frame.
