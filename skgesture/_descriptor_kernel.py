@@ -21,7 +21,8 @@ import math
 import numba
 import numpy as np
 
-MIN_NORM = 1e-8  # as skgesture._descriptor.MIN_NORM
+from skgesture._descriptor import MIN_NORM
+
 TWO_PI_3 = 2.0 * np.pi / 3.0
 BORDER_CODES = {"replicate": 0, "zero": 1, "symmetric": 2}
 BLOCK_VALUES = 16384  # floats of a block of features (128 KiB, in the L2 cache)

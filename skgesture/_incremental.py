@@ -46,6 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from skgesture._descriptor import DEGENERATE_INCLINATION, MIN_NORM
 from skgesture.utils._smoothing import loess_kernel, loess_smooth
 
 __all__ = [
@@ -459,9 +460,6 @@ def fast_proba(estimator):
 
 
 # -- the descriptor, one frame at a time -----------------------------------------
-
-MIN_NORM = 1e-8  # as skgesture._descriptor (docs/method.md §3.9-3.11)
-DEGENERATE_INCLINATION = np.pi / 2  # decision D8
 
 
 def _dot3(u, v):
