@@ -113,13 +113,18 @@ def main(argv=None):
 
     # %%
     # Descriptors
+    # The first call of a new installation compiles the descriptor kernel (numba,
+    # about 10 s once, then cached on disk); time it apart from the real work.
+    t0 = time.perf_counter()
+    PoseDescriptor().fit_transform(synth.X[:1])
+    warm = time.perf_counter() - t0
     t0 = time.perf_counter()
     D = PoseDescriptor().fit_transform(synth.X)
     dt = time.perf_counter() - t0
     n = sum(len(d) for d in D)
     print(
         f"\nPoseDescriptor: {n:,} frames -> {D[0].shape[1]}-D in {dt:.2f} s "
-        f"({n / dt:,.0f} frames/s, fit + transform)"
+        f"({n / dt:,.0f} frames/s, fit + transform; first call {warm:.1f} s)"
     )
 
     # %%
