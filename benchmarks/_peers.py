@@ -178,7 +178,7 @@ class GRUPeer(_PeerBase):
     def _fit(self, F, y):
         import torch
 
-        from skgesture._networks import torch_threads
+        from skgesture._nn._training import torch_threads
 
         rng = np.random.default_rng(self.random_state)
         allf = np.concatenate(F)
@@ -219,7 +219,7 @@ class GRUPeer(_PeerBase):
     def _predict_index(self, f):
         import torch
 
-        from skgesture._networks import torch_threads
+        from skgesture._nn._training import torch_threads
 
         z = ((f - self.mean_) / self.scale_).astype(np.float32)
         with torch_threads(1), torch.no_grad():

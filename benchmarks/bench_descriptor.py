@@ -13,7 +13,7 @@ import time
 
 from _common import one_core
 
-import skgesture._descriptor as descriptor_module
+import skgesture._descriptor._compute as descriptor_module
 from skgesture import PoseDescriptor
 from skgesture.datasets import make_gesture_streams
 

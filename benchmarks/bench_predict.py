@@ -28,7 +28,7 @@ import time
 import numpy as np
 from _common import one_core
 
-import skgesture._descriptor as descriptor_module
+import skgesture._descriptor._compute as descriptor_module
 from skgesture import make_method_a, make_method_b
 from skgesture.datasets import load_precog, make_gesture_streams
 

@@ -351,7 +351,8 @@ def _window(pipe, name, X_te, y_te, fps, quick):
 
 def _carries_state(tagger):
     """Whether the tagger's stream carries a recurrent state (no past window)."""
-    from skgesture._incremental import RecurrentScorer, VotingScorer
+    from skgesture._nn._fast import RecurrentScorer
+    from skgesture._taggers._stream import VotingScorer
 
     scorer = tagger._stream_scorer(0)
     scorers = scorer.scorers if isinstance(scorer, VotingScorer) else [scorer]

@@ -12,19 +12,22 @@ Public names are imported lazily, so ``import skgesture`` does not import torch.
 
 import importlib
 
+from skgesture import _legacy
 from skgesture._version import __version__
+
+_legacy.install()  # the module paths of 0.1, for old model files
 
 _LAZY = {
     "PoseDescriptor": "skgesture._descriptor",
     "ActivitySegmenter": "skgesture._segmenter",
     "DynamicPoseWindow": "skgesture._windows",
     "MultiScaleClassifier": "skgesture._multiscale",
-    "BiLSTMTagger": "skgesture._bilstm",
-    "TorchMLPClassifier": "skgesture._mlp",
+    "BiLSTMTagger": "skgesture._taggers._bilstm",
+    "TorchMLPClassifier": "skgesture._nn._mlp",
     "JointFeatures": "skgesture._features",
     "SkeletonAugmenter": "skgesture._augment",
-    "SequenceTagger": "skgesture._tagger",
-    "VotingTagger": "skgesture._tagger",
+    "SequenceTagger": "skgesture._taggers._sequence",
+    "VotingTagger": "skgesture._taggers._voting",
     "make_recommended": "skgesture._pipelines",
     "make_method_a": "skgesture._pipelines",
     "make_method_b": "skgesture._pipelines",

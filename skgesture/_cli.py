@@ -237,7 +237,7 @@ def _set_if_present(est, **params):
 def _make_model(args, verbose):
     """The unfitted pipeline of ``--method`` with the size options applied."""
     import skgesture
-    from skgesture._multiscale import default_window_network
+    from skgesture._multiscale._classifier import default_window_network
     from skgesture._segmenter import default_frame_network
 
     method = args.method

@@ -16,8 +16,10 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
-from skgesture._descriptor import _fill_missing
+from skgesture._descriptor._compute import _fill_missing
+from skgesture._stream import DEFAULT_MAX_BACKFILL, Rows
 from skgesture.layouts import KINECT_V1, N_COORDS, get_descriptor_joints
+from skgesture.utils._buffers import RowBuffer, RunningMedian, _concat_rows
 from skgesture.utils._validation import (
     check_skeletons,
     missing_frames,
@@ -107,7 +109,7 @@ def joint_features(
 
 
 # The steps of joint_features, shared with the stream step of JointFeatures
-# (skgesture/_incremental.py, JointFeatureStream), which applies them to the
+# (JointFeatureStream, below), which applies them to the
 # frames a row needs with the statistics of a trailing window.
 
 
@@ -375,7 +377,7 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         return tags
 
     # -- incremental step (docs/design.md §4.1, "Incremental steps") -----------
-    # The state and the per-row arithmetic live in skgesture/_incremental.py
+    # The state and the per-row arithmetic are JointFeatureStream, below
     # (JointFeatureStream), built on the steps of joint_features above.
 
     def stream_init(self, *, max_backfill=64, **options):
@@ -398,7 +400,7 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         Examples
         --------
         >>> from skgesture import JointFeatures
-        >>> from skgesture._incremental import stream_frames
+        >>> from skgesture._stream import stream_frames
         >>> from skgesture.utils._testing import make_skeleton_stream
         >>> X, _ = make_skeleton_stream(random_state=0)
         >>> feats = JointFeatures(stream_warmup=0).fit([X])
@@ -410,7 +412,7 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         >>> len(last), rows.data.shape[1] == feats.n_features_out_
         (1, True)
         """
-        from skgesture._incremental import JointFeatureStream
+        from skgesture._features import JointFeatureStream
 
         check_is_fitted(self)
         names, _ = _joint_names(self.joints)
@@ -449,7 +451,8 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         state : object
             The updated state.
         """
-        from skgesture._incremental import Rows, check_stream_frames
+        from skgesture._stream import Rows
+        from skgesture.utils._validation import check_stream_frames
 
         frames = check_stream_frames(self, rows.data, int(rows.time[0]))
         return state.step(Rows(frames, rows.mask, rows.time)), state
@@ -479,3 +482,181 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         and accelerations.
         """
         return 2 if self.accelerations else int(bool(self.velocities))
+
+
+class JointFeatureStream:
+    """State of :meth:`JointFeatures.stream_step` for one stream.
+
+    The offline arithmetic of :func:`skgesture._features.joint_features`
+    (``_frame_quantities``, ``_statistics``, ``_normalised``,
+    ``_with_derivatives``) on the frames a row needs, with the sequence
+    statistics (median trunk length, median hip position, median hip
+    direction) taken over the last ``stream_stats_window`` tracked frames
+    received when the row is emitted. A row is emitted once the frames its
+    derivatives read have arrived (1 frame later with velocities, 2 with
+    accelerations) but not before frame ``stream_warmup - 1`` (the first rows
+    wait for the statistics of the first ``stream_warmup`` frames); all the
+    frames it reads are normalised with the statistics of that moment, so its
+    velocity is that of one consistent body frame. Untracked frames are held
+    (the last tracked frame repeats, ``fill="hold"``) and masked; untracked
+    frames at the start wait for the first tracked frame and become copies of
+    it, the last ``max_backfill`` of them, earlier ones are handed on at once
+    as masked zero rows.
+    """
+
+    def __init__(self, feats, max_backfill=DEFAULT_MAX_BACKFILL):
+        from skgesture._features import (
+            _frame_quantities,
+            _normalised,
+            _statistics,
+            _with_derivatives,
+        )
+
+        self.quantities = _frame_quantities
+        self.statistics = _statistics
+        self.normalised = _normalised
+        self.derivatives = _with_derivatives
+        self.index = feats._joint_index
+        self.velocities = bool(feats.velocities)
+        self.accelerations = bool(feats.accelerations)
+        self.align = bool(feats.align)
+        self.a = 2 if self.accelerations else int(self.velocities)
+        # (getattr: a model saved before these parameters existed streams too)
+        self.window = int(getattr(feats, "stream_stats_window", 600))
+        self.ready = int(getattr(feats, "stream_warmup", 0)) - 1  # ends the warm-up
+        self.width = int(feats.n_features_out_)
+        self.max_backfill = int(max_backfill)
+        self.R = RowBuffer((20, 3), capacity=32)  # filled raw frames, from p0
+        self.untracked = RowBuffer((), dtype=bool, capacity=32)
+        self.times = RowBuffer((), dtype=np.int64, capacity=32)
+        self.Q = RowBuffer((7,), capacity=64)  # quantities of the tracked frames
+        self.Q_frame = RowBuffer((), dtype=np.int64, capacity=64)  # their frames
+        self.n_in = 0
+        self.n_out = 0
+        self.p0 = None  # first frame with a filled raw frame
+        self.f = None  # first tracked frame
+        self.last = None  # the last tracked frame
+        self.medians = RunningMedian(7 if self.align else 4, self.window)
+        self.cached = (None, None)  # (tracked frames used, statistics)
+
+    def step(self, rows):
+        """Validated raw frames in; the feature rows that became final out."""
+        from skgesture.utils._validation import missing_frames
+
+        frames, times = rows.data, rows.time
+        first = self.n_in
+        self.n_in += len(frames)
+        untracked = missing_frames(frames)
+        self.untracked.append(untracked)
+        self.times.append(times)
+        tracked = ~untracked
+        if tracked.any():
+            self.Q.append(self.quantities(frames[tracked]))
+            self.Q_frame.append(first + np.flatnonzero(tracked))
+        out = []
+        if self.p0 is None:
+            if untracked.all():
+                out.append(self._zeros(self.n_in - self.max_backfill))
+                return _concat_rows(out, (self.width,), np.float32)
+            k = int(np.argmax(tracked))
+            out.append(self._zeros(first + k - self.max_backfill))
+            self.p0, self.f = self.n_out, first + k
+            self.R.restart(self.p0)
+            # The leading frames kept back become copies of the first tracked one.
+            self.R.append(np.repeat(frames[k : k + 1], self.f - self.p0, axis=0))
+            self.last = frames[k]
+            frames, untracked = frames[k:], untracked[k:]
+        if untracked.any():  # hold: an untracked frame repeats the last tracked one
+            frames = frames.copy()
+            src = np.maximum.accumulate(
+                np.where(~untracked, np.arange(len(frames)), -1)
+            )
+            frames[src < 0] = self.last
+            frames[src >= 0] = frames[src[src >= 0]]
+        self.last = frames[-1]
+        self.R.append(frames)
+        out.append(self._advance())
+        return _concat_rows(out, (self.width,), np.float32)
+
+    def flush(self):
+        """The remaining rows, the end rows with one-sided differences."""
+        if self.p0 is None:
+            return self._zeros(self.n_in)
+        return self._emit(self.n_out, self.n_in, self.n_in - 1)
+
+    def _advance(self):
+        """Rows final with the frames received: row ``t`` at frame
+        ``max(t + a, first tracked frame, end of warm-up)``."""
+        now = self.n_in - 1
+        start = max(self.f, self.ready)
+        if now < start:
+            return Rows.empty((self.width,), np.float32)
+        parts = []
+        # Rows whose derivatives were complete before the warm-up ended (or
+        # the first tracked frame arrived) share the statistics of that frame.
+        shared = min(start - self.a + 1, now - self.a + 1)
+        if shared > self.n_out:
+            parts.append(self._emit(self.n_out, shared, start))
+        for t in range(self.n_out, now - self.a + 1):
+            parts.append(self._emit(t, t + 1, t + self.a))
+        return _concat_rows(parts, (self.width,), np.float32)
+
+    def _stats(self, tau):
+        """Statistics of the last ``window`` tracked frames up to frame ``tau``."""
+        frames = self.Q_frame.data(self.Q_frame.start, self.Q_frame.stop)
+        k = self.Q_frame.start + int(np.searchsorted(frames, tau, side="right"))
+        if self.cached[0] != k:
+            # The tracked frames up to tau join the sorted window in order.
+            cols = self.medians.n_columns
+            for row in self.Q.data(self.medians.n_added, k)[:, :cols].tolist():
+                self.medians.add(row)
+            median = self.medians.median()
+            self.cached = (k, self.statistics(None, self.align, median=median))
+        return self.cached[1]
+
+    def _emit(self, lo, hi, tau):
+        """Rows ``lo .. hi - 1`` with the statistics at frame ``tau``."""
+        if hi <= lo:
+            return Rows.empty((self.width,), np.float32)
+        a = self.a
+        b0 = max(lo - a, self.p0)
+        b1 = min(hi + a, tau + 1)
+        flat = self.normalised(self.R.data(b0, b1), self.index, self._stats(tau))
+        data = self.derivatives(flat, self.velocities, self.accelerations)
+        rows = Rows(
+            np.ascontiguousarray(data[lo - b0 : hi - b0]),
+            self.untracked.data(lo, hi).copy(),
+            np.full(hi - lo, self.times.data(tau, tau + 1)[0], dtype=np.int64),
+        )
+        self.n_out = hi
+        self._trim()
+        return rows
+
+    def _trim(self):
+        keep = self.n_out
+        self.R.drop(max(keep - self.a, self.p0 or 0))
+        self.untracked.drop(keep)
+        self.times.drop(keep)
+        if self.cached[0] is not None:  # the sorted window holds them now
+            self.Q.drop(self.cached[0])
+            self.Q_frame.drop(self.cached[0])
+
+    def _zeros(self, until):
+        """Hand on the leading untracked frames before ``until`` as zero rows."""
+        lo = self.n_out
+        if until <= lo:
+            return Rows.empty((self.width,), np.float32)
+        self.n_out = until
+        n = until - lo
+        rows = Rows(
+            np.zeros((n, self.width), dtype=np.float32),
+            np.ones(n, dtype=bool),
+            self.times.data(lo, until).copy(),
+        )
+        self.untracked.drop(until)
+        self.times.drop(until)
+        return rows
+
+    def held(self):
+        """Rows held by the buffers."""
+        return {"frames": len(self.R), "tracked": len(self.medians)}

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from skgesture._legacy import MOVED
 from skgesture._version import __version__
 
 __all__ = [
@@ -74,17 +75,23 @@ _TRAINING_ONLY = {"callbacks", "train_split"}
 # skgesture modules whose estimator classes are trusted by load_model.
 _TRUSTED_MODULES = (
     "skgesture._augment",
-    "skgesture._bilstm",
     "skgesture._descriptor",
+    "skgesture._descriptor._estimator",
     "skgesture._features",
-    "skgesture._modules",
-    "skgesture._mlp",
     "skgesture._multiscale",
+    "skgesture._multiscale._classifier",
+    "skgesture._nn._mlp",
+    "skgesture._nn._modules",
+    "skgesture._nn._sequence_net",
+    "skgesture._nn._training",
     "skgesture._segmenter",
-    "skgesture._tagger",
+    "skgesture._taggers._bilstm",
+    "skgesture._taggers._sequence",
+    "skgesture._taggers._voting",
     "skgesture._windows",
     "skgesture.layouts",
     "skgesture._persistence",
+    *MOVED,  # files written by 0.1
 )
 
 
@@ -491,7 +498,7 @@ def _input_layout(estimator):
         "layout": None,
         "joints": None,
     }
-    from skgesture._descriptor import PoseDescriptor
+    from skgesture._descriptor._estimator import PoseDescriptor
 
     if isinstance(first, PoseDescriptor):
         from skgesture.layouts import KINECT_V1

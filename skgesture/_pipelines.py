@@ -5,12 +5,15 @@
 from sklearn.pipeline import Pipeline
 
 from skgesture._augment import SkeletonAugmenter
-from skgesture._bilstm import BiLSTMTagger
-from skgesture._descriptor import PoseDescriptor
+from skgesture._descriptor._estimator import PoseDescriptor
 from skgesture._features import JointFeatures
-from skgesture._multiscale import MultiScaleClassifier, default_window_network
+from skgesture._multiscale._classifier import (
+    MultiScaleClassifier,
+    default_window_network,
+)
 from skgesture._segmenter import ActivitySegmenter, default_frame_network
-from skgesture._tagger import SequenceTagger
+from skgesture._taggers._bilstm import BiLSTMTagger
+from skgesture._taggers._sequence import SequenceTagger
 from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
 
 __all__ = ["make_method_a", "make_method_b", "make_method_c", "make_recommended"]

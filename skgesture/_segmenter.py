@@ -10,10 +10,13 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
-from skgesture._mlp import TorchMLPClassifier
-from skgesture._networks import fit_inner_estimator
+from skgesture._nn._fast import fast_proba
+from skgesture._nn._mlp import TorchMLPClassifier
+from skgesture._nn._training import fit_inner_estimator
+from skgesture._stream import Rows
+from skgesture.utils._buffers import RowBuffer, _concat_rows
 from skgesture.utils._segments import remove_short_runs, runs
-from skgesture.utils._smoothing import loess_smooth
+from skgesture.utils._smoothing import LoessStepper, loess_smooth
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -391,7 +394,7 @@ class ActivitySegmenter(
         return tags
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
-    # The state (skgesture/_incremental.py, SegmenterStream) uses the same
+    # The state (skgesture/_segmenter.py, SegmenterStream) uses the same
     # network, loess and rules as predict; tests/test_streaming.py checks it.
 
     def stream_init(self, **options):
@@ -407,7 +410,7 @@ class ActivitySegmenter(
         object
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._incremental import SegmenterStream
+        from skgesture._segmenter import SegmenterStream
 
         check_is_fitted(self)
         return SegmenterStream(self)
@@ -457,6 +460,80 @@ class ActivitySegmenter(
     @property
     def stream_lookahead(self):
         """Frames of smoothing look-ahead, ``(smooth_span - 1) // 2`` (7)."""
-        from skgesture._incremental import check_stream_span
+        from skgesture.utils._smoothing import check_stream_span
 
         return (check_stream_span(self.smooth_span, "smooth_span") - 1) // 2
+
+
+class SegmenterStream:
+    """State of :meth:`ActivitySegmenter.stream_step` for one stream.
+
+    Scores every descriptor row, smooths the score track with the causal
+    loess (:class:`LoessStepper`), thresholds it and keeps the runs of active
+    frames of at least ``min_length`` frames (``remove_short_runs``). An
+    active row is handed on once its run reaches ``min_length`` frames, a rest
+    row at once; the rows are the descriptors, masked where at rest.
+    Untracked (masked) rows are rest.
+    """
+
+    def __init__(self, seg):
+        self.proba = fast_proba(seg.estimator_)
+        self.column = list(seg.estimator_.classes_).index(1)
+        self.smoother = LoessStepper(
+            seg.smooth_span, 1, owner="ActivitySegmenter.smooth_span"
+        )
+        self.threshold = seg.threshold
+        self.min_length = seg.min_length
+        self.rows = None  # descriptor rows not yet handed on
+        self.n_out = 0
+        self.run_start = None  # first row of the current run of active rows
+        self.last_time = 0
+
+    def step(self, rows):
+        if self.rows is None:
+            self.rows = RowBuffer(rows.data.shape[1:], capacity=64)
+        self.rows.append(rows.data, rows.mask, rows.time)
+        self.last_time = int(rows.time[-1])
+        score = self.proba(rows.data)[:, self.column]
+        lo, smoothed, times = self.smoother.step(score[:, None], rows.time)
+        return self._decide(lo, smoothed[:, 0], times)
+
+    def flush(self):
+        if self.rows is None:
+            return None
+        lo, smoothed, times = self.smoother.flush(self.last_time)
+        out = self._decide(lo, smoothed[:, 0], times)
+        # A run still shorter than min_length at the end is rest.
+        tail = self._hand_on(self.rows.stop, False, self.last_time)
+        return _concat_rows([out, tail], self.rows._data.shape[1:])
+
+    def _decide(self, lo, smoothed, times):
+        untracked = self.rows.mask(lo, lo + len(smoothed))
+        active = (smoothed > self.threshold) & ~untracked
+        out = []
+        for i, on in enumerate(active.tolist()):
+            u = lo + i
+            if on:
+                if self.run_start is None:
+                    self.run_start = u
+                if u + 1 - self.run_start >= self.min_length:
+                    out.append(self._hand_on(u + 1, True, times[i]))
+            else:
+                # A run shorter than min_length is rest, with this row.
+                self.run_start = None
+                out.append(self._hand_on(u + 1, False, times[i]))
+        return _concat_rows(out, self.rows._data.shape[1:])
+
+    def _hand_on(self, stop, active, time):
+        lo = self.n_out
+        if stop <= lo:
+            return Rows.empty(self.rows._data.shape[1:])
+        block = self.rows.rows(lo, stop)
+        block.mask = np.full(stop - lo, not active)
+        block.time = np.full(stop - lo, time, dtype=np.int64)
+        self.n_out = stop
+        self.rows.drop(stop)
+        return block
+
+    def held(self):
+        return {"scores": self.smoother.held(), "pending": len(self.rows or ())}

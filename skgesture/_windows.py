@@ -517,7 +517,7 @@ class DynamicPoseWindow(TransformerMixin, BaseEstimator, auto_wrap_output_keys=N
         object
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._incremental import WindowStream
+        from skgesture._windows import WindowStream
 
         check_is_fitted(self)
         return WindowStream(self)
@@ -574,3 +574,34 @@ class DynamicPoseWindow(TransformerMixin, BaseEstimator, auto_wrap_output_keys=N
         * (n_poses - 1) // 2``, counts in the classifier's.
         """
         return 0
+
+
+class WindowStream:
+    """State of :meth:`DynamicPoseWindow.stream_step`: the descriptor rows, as
+    lazy windows.
+
+    A window centred at frame ``u`` needs the descriptors up to ``u + hw``,
+    and the classifier needs to know whether frame ``u + hw`` is still in the
+    period before it scores that window. So in a stream the windows are built
+    where they are used: this stage hands the descriptor rows on at once,
+    tagged with its ``steps`` and ``n_poses`` (``rows.info["windows"]``), and
+    :class:`MultiScaleStream` builds the windows of the centres it scores with
+    :func:`~skgesture._windows.dynamic_poses`, the function of the offline
+    ``transform``. Dense windows of every frame are never made (the classifier
+    reads one window every ``stride`` frames of a period).
+    """
+
+    def __init__(self, windows):
+        from skgesture._windows import check_steps
+
+        self.layout = (check_steps(windows.steps, windows.n_poses), windows.n_poses)
+
+    def step(self, rows):
+        rows.info = {**(rows.info or {}), "windows": self.layout}
+        return rows
+
+    def flush(self):
+        return None
+
+    def held(self):
+        return {}

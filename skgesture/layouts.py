@@ -22,6 +22,10 @@ __all__ = [
     "PAPER_11",
     "FULL_BODY_20",
     "get_descriptor_joints",
+    "KINECT_V2_JOINTS",
+    "AZURE_KINECT_JOINTS",
+    "MEDIAPIPE_POSE_LANDMARKS",
+    "MSR_ACTION3D_TO_KINECT_V1",
 ]
 
 
@@ -281,3 +285,57 @@ def get_descriptor_joints(joints):
             f"joints must be one of {sorted(_DESCRIPTOR_JOINTS)} or a "
             f"DescriptorJoints instance, got {joints!r}"
         ) from None
+
+
+# Kinect for Windows SDK 2.0 ``JointType`` order (25 joints).
+KINECT_V2_JOINTS = (
+    "SpineBase", "SpineMid", "Neck", "Head",
+    "ShoulderLeft", "ElbowLeft", "WristLeft", "HandLeft",
+    "ShoulderRight", "ElbowRight", "WristRight", "HandRight",
+    "HipLeft", "KneeLeft", "AnkleLeft", "FootLeft",
+    "HipRight", "KneeRight", "AnkleRight", "FootRight",
+    "SpineShoulder", "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight",
+)  # fmt: skip
+
+
+# Azure Kinect Body Tracking SDK ``k4abt_joint_id_t`` order (32 joints).
+AZURE_KINECT_JOINTS = (
+    "PELVIS", "SPINE_NAVEL", "SPINE_CHEST", "NECK",
+    "CLAVICLE_LEFT", "SHOULDER_LEFT", "ELBOW_LEFT", "WRIST_LEFT",
+    "HAND_LEFT", "HANDTIP_LEFT", "THUMB_LEFT",
+    "CLAVICLE_RIGHT", "SHOULDER_RIGHT", "ELBOW_RIGHT", "WRIST_RIGHT",
+    "HAND_RIGHT", "HANDTIP_RIGHT", "THUMB_RIGHT",
+    "HIP_LEFT", "KNEE_LEFT", "ANKLE_LEFT", "FOOT_LEFT",
+    "HIP_RIGHT", "KNEE_RIGHT", "ANKLE_RIGHT", "FOOT_RIGHT",
+    "HEAD", "NOSE", "EYE_LEFT", "EAR_LEFT", "EYE_RIGHT", "EAR_RIGHT",
+)  # fmt: skip
+
+
+# MediaPipe Pose (BlazePose) landmark order (33 landmarks).
+MEDIAPIPE_POSE_LANDMARKS = (
+    "nose", "left_eye_inner", "left_eye", "left_eye_outer",
+    "right_eye_inner", "right_eye", "right_eye_outer", "left_ear", "right_ear",
+    "mouth_left", "mouth_right", "left_shoulder", "right_shoulder",
+    "left_elbow", "right_elbow", "left_wrist", "right_wrist",
+    "left_pinky", "right_pinky", "left_index", "right_index",
+    "left_thumb", "right_thumb", "left_hip", "right_hip",
+    "left_knee", "right_knee", "left_ankle", "right_ankle",
+    "left_heel", "right_heel", "left_foot_index", "right_foot_index",
+)  # fmt: skip
+
+
+# For each Kinect v1 NUI joint (HipCenter, Spine, ShoulderCenter, Head,
+# ShoulderLeft, ElbowLeft, WristLeft, HandLeft, ShoulderRight, ElbowRight,
+# WristRight, HandRight, HipLeft, KneeLeft, AnkleLeft, FootLeft, HipRight,
+# KneeRight, AnkleRight, FootRight) the 0-based index of the same joint in the MSR
+# Action3D file order (data PROVENANCE: 1 left shoulder, 2 right shoulder,
+# 3 shoulder centre, 4 spine, 5 left hip, 6 right hip, 7 hip centre, 8/9 elbows,
+# 10/11 wrists, 12/13 hands, 14/15 knees, 16/17 ankles, 18/19 feet, 20 head).
+# Use as ``X_kinect = X_msr[:, MSR_ACTION3D_TO_KINECT_V1]``.
+MSR_ACTION3D_TO_KINECT_V1 = (
+    6, 3, 2, 19,
+    0, 7, 9, 11,
+    1, 8, 10, 12,
+    4, 13, 15, 17,
+    5, 14, 16, 18,
+)  # fmt: skip

@@ -19,18 +19,17 @@ from sklearn.model_selection import GridSearchCV, GroupKFold  # noqa: E402
 from sklearn.pipeline import Pipeline  # noqa: E402
 
 from skgesture import BiLSTMTagger, PoseDescriptor, make_method_c  # noqa: E402
-from skgesture._bilstm import (  # noqa: E402
+from skgesture._nn._modules import RecurrentTaggerModule, _BiLSTMModule  # noqa: E402
+from skgesture._nn._training import FramewiseLoss  # noqa: E402
+from skgesture._taggers._bilstm import (  # noqa: E402
     IGNORE_INDEX,
     PAPER_MODULE,
-    _BiLSTMModule,
     _BiLSTMNet,
     _chunks,
     _SequenceHoldout,
     _training_windows,
     sample_windows,
 )
-from skgesture._modules import RecurrentTaggerModule  # noqa: E402
-from skgesture._networks import FramewiseLoss  # noqa: E402
 from skgesture.metrics import jaccard_index  # noqa: E402
 from skgesture.utils._testing import make_skeleton_stream  # noqa: E402
 

@@ -8,7 +8,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from skgesture import PoseDescriptor
-from skgesture._descriptor import (
+from skgesture._descriptor._compute import (
     _body_frame,
     _distances,
     _fill_missing,

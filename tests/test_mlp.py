@@ -10,7 +10,7 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 
 from skgesture import TorchMLPClassifier
-from skgesture._networks import seed_from
+from skgesture._nn._training import seed_from
 
 SOLVERS = ("scg", "adam", "lbfgs")
 FAST = {"hidden_layer_sizes": (8,), "activations": ("tanh",), "max_epochs": 30}
@@ -241,7 +241,7 @@ class _FakeNet:
 def _run_stopping(initial_loss, losses, grad_norms=None, **params):
     """Epochs 1, 2, ... with these validation losses; the weight of the module
     is the epoch number. Returns (epochs run, weight restored at the end)."""
-    from skgesture._networks import _MatlabStopping
+    from skgesture._nn._training import _MatlabStopping
 
     stop = _MatlabStopping(**params)
     net = _FakeNet(initial_loss)
@@ -294,7 +294,7 @@ def test_min_grad_stop_at_1e_6_by_default():
 
 
 def test_max_epochs_defaults_to_trainscg_1000():
-    from skgesture._multiscale import default_window_network
+    from skgesture._multiscale._classifier import default_window_network
     from skgesture._segmenter import default_frame_network
 
     assert TorchMLPClassifier().max_epochs == 1000
@@ -310,7 +310,7 @@ def test_initial_validation_loss_is_the_recorded_validation_loss():
     # on the validation split, averaged over its samples
     from skorch.dataset import Dataset
 
-    from skgesture._networks import _mean_loss
+    from skgesture._nn._training import _mean_loss
 
     X, y = BINARY
     clf = _clf(max_epochs=3, random_state=0).fit(X, y)
@@ -369,7 +369,7 @@ def test_mlp_verbose_1_shows_a_bar_and_0_nothing(capsys):
 
 def test_multiclass_loss_is_matlab_crossentropy_over_samples_and_outputs():
     # docs/method.md §8.6.5: perf = sum(-t log y) / numel, samples x outputs
-    from skgesture._networks import MatlabCrossEntropy, build_net
+    from skgesture._nn._training import MatlabCrossEntropy, build_net
 
     rng = np.random.RandomState(0)
     logits = torch.as_tensor(rng.normal(size=(7, 4)))

@@ -10,7 +10,7 @@ from sklearn.linear_model import LogisticRegression
 from sklearn.utils._param_validation import InvalidParameterError
 
 from skgesture import DynamicPoseWindow, MultiScaleClassifier, TorchMLPClassifier
-from skgesture._multiscale import decide_period
+from skgesture._multiscale._rules import decide_period
 from skgesture.metrics import labels_to_segments
 
 # --------------------------------------------------------------------------------
@@ -536,7 +536,7 @@ def test_multiscale_resized_period_short_rule_labels_every_original_frame(resize
 
 
 def test_resized_frames_inverts_the_resampling_map():
-    from skgesture._multiscale import _resized_frames
+    from skgesture._multiscale._rules import _resized_frames
 
     # imresize: output u <- input (u + 0.5) L / n - 0.5, so input t -> nearest u
     assert _resized_frames(12, 17, "bicubic").tolist() == [

@@ -160,7 +160,7 @@ def test_bare_net_with_tensor_and_array_parameters(tmp_path):
     # and an array among its attributes: both go to safetensors and come back.
     from skorch import NeuralNet
 
-    from skgesture._networks import MLPModule
+    from skgesture._nn._modules import MLPModule
 
     rng = np.random.RandomState(0)
     X = rng.normal(size=(40, 3)).astype(np.float32)
@@ -304,8 +304,8 @@ def test_untrusted_type_in_the_schema_is_refused(saved_b, tmp_path):
     with zipfile.ZipFile(src) as zf:
         files = {n: zf.read(n) for n in zf.namelist()}
     schema = files["schema.json"].decode()
-    assert '"skgesture._descriptor"' in schema
-    schema = schema.replace('"skgesture._descriptor"', '"os"').replace(
+    assert '"skgesture._descriptor._estimator"' in schema
+    schema = schema.replace('"skgesture._descriptor._estimator"', '"os"').replace(
         '"PoseDescriptor"', '"system"'
     )
     files["schema.json"] = schema.encode()

@@ -17,7 +17,7 @@ import torch
 from numpy.testing import assert_allclose, assert_array_equal
 
 import skgesture
-import skgesture._descriptor as descriptor_module
+import skgesture._descriptor._compute as descriptor_module
 from skgesture import PoseDescriptor
 from skgesture.datasets import make_gesture_streams
 from skgesture.utils._validation import missing_frames
@@ -103,7 +103,7 @@ def test_compiled_kernel_equals_numpy_on_streams_with_dropouts(params, monkeypat
 def test_compiled_kernel_is_used_when_numba_is_installed(monkeypatch):
     pytest.importorskip("numba")
     monkeypatch.setattr(descriptor_module, "USE_COMPILED", True)  # not disabled
-    from skgesture import _descriptor_kernel
+    from skgesture._descriptor import _kernel as _descriptor_kernel
 
     calls = []
     real = _descriptor_kernel.describe_batch
@@ -122,8 +122,8 @@ def test_numpy_fallback_without_numba(monkeypatch):
     import sys
 
     monkeypatch.setitem(sys.modules, "numba", None)  # as if not installed
-    monkeypatch.delitem(sys.modules, "skgesture._descriptor_kernel", raising=False)
-    monkeypatch.delattr(skgesture, "_descriptor_kernel", raising=False)
+    monkeypatch.delitem(sys.modules, "skgesture._descriptor._kernel", raising=False)
+    monkeypatch.delattr(skgesture._descriptor, "_kernel", raising=False)
     monkeypatch.setattr(descriptor_module, "USE_COMPILED", True)
     assert descriptor_module._compiled_kernel() is None
     data = make_gesture_streams(2, random_state=0)

@@ -22,17 +22,12 @@ from skgesture import (
     make_method_b,
     make_method_c,
 )
-from skgesture._incremental import (
-    LabelRuns,
-    LoessStepper,
-    Rows,
-    StreamSegment,
-    TrailingWindowStream,
-    stream_frames,
-)
+from skgesture._stream import Rows, StreamSegment, stream_frames
+from skgesture._taggers._decoding import LabelRuns
+from skgesture._taggers._stream import TrailingWindowStream
 from skgesture.datasets import load_precog, make_gesture_streams
 from skgesture.streaming import GestureEvent, StreamingRecognizer
-from skgesture.utils._smoothing import loess_smooth
+from skgesture.utils._smoothing import LoessStepper, loess_smooth
 
 TRAIN_SUBJECTS = (1, 2)  # PRECOG (real Kinect v1 streams, bundled)
 TEST_SUBJECTS = (8,)
@@ -222,7 +217,7 @@ def test_descriptor_stream_gives_the_rows_of_transform(precog, monkeypatch, comp
     parameter of PoseDescriptor, one frame or a block at a time: with the
     compiled kernel (the batch code on the frames a row needs) and without it
     (the per-frame arithmetic of FrameDescriber against the numpy batch)."""
-    import skgesture._descriptor as descriptor_module
+    import skgesture._descriptor._compute as descriptor_module
 
     if compiled and descriptor_module._compiled_kernel() is None:
         pytest.skip("numba is not installed")

@@ -8,21 +8,17 @@ import pytest
 from sklearn.utils._param_validation import InvalidParameterError
 
 from skgesture import JointFeatures, SequenceTagger, VotingTagger, make_recommended
-from skgesture._decoding import decode, smooth_proba
 from skgesture._features import (
     _frame_quantities,
     _normalised,
     _statistics,
     _with_derivatives,
 )
-from skgesture._incremental import (
-    LabelRuns,
-    MeanStepper,
-    make_smoother,
-    stream_frames,
-)
+from skgesture._stream import stream_frames
+from skgesture._taggers._decoding import LabelRuns, decode, make_smoother, smooth_proba
 from skgesture.datasets import load_precog
 from skgesture.streaming import StreamingRecognizer
+from skgesture.utils._smoothing import MeanStepper
 
 TINY = {"max_epochs": 1, "steps_per_epoch": 3, "crop_length": 32, "batch_size": 8}
 # Streamed exactly as offline: the whole stream in the statistics window, no
@@ -257,8 +253,8 @@ def test_numpy_tcn_equals_the_module():
     probabilities (every block length, dilations beyond the block included)."""
     import torch
 
-    from skgesture._incremental import TemporalConvProba
-    from skgesture._modules import TemporalConvModule, frame_probabilities
+    from skgesture._nn._fast import TemporalConvProba
+    from skgesture._nn._modules import TemporalConvModule, frame_probabilities
 
     torch.manual_seed(0)
     rng = np.random.RandomState(0)
@@ -280,8 +276,9 @@ def test_recurrent_scorer_equals_the_module(cell, activation):
     backward passes give the module's probabilities, row by row or at once."""
     import torch
 
-    from skgesture._incremental import RecurrentScorer, RowBuffer
-    from skgesture._modules import RecurrentTaggerModule, frame_probabilities
+    from skgesture._nn._fast import RecurrentScorer
+    from skgesture._nn._modules import RecurrentTaggerModule, frame_probabilities
+    from skgesture.utils._buffers import RowBuffer
 
     torch.manual_seed(0)
     rng = np.random.RandomState(0)

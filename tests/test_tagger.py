@@ -17,7 +17,7 @@ from skgesture import (
     make_recommended,
 )
 from skgesture._augment import time_warp
-from skgesture._decoding import decode, fill_short_gaps
+from skgesture._taggers._decoding import decode, fill_short_gaps
 from skgesture.metrics import jaccard_index
 from skgesture.utils._testing import make_skeleton_stream
 
@@ -148,7 +148,7 @@ def test_decoding_parameters_change_predictions_without_retraining(toy, tmp_path
     first = tagger.predict(X[5:])[0]
     cached = clone(tagger).set_params(min_run=60, smooth_span=9)
     calls = []
-    import skgesture._tagger as module
+    import skgesture._nn._sequence_net as module
 
     original = module._CropNet.fit
 
@@ -236,7 +236,7 @@ def test_augmenter_parameters_are_validated(params):
 
 
 def test_training_crops_keep_labels_aligned(toy):
-    from skgesture._tagger import _CropData
+    from skgesture._nn._sequence_net import _CropData
 
     X, y = toy
     data = _CropData(
@@ -449,7 +449,7 @@ def test_make_recommended_in_grid_search_with_groups(tmp_path):
 def test_loss_of_a_batch_whose_frames_are_all_ignored_is_zero_not_nan():
     import torch
 
-    from skgesture._networks import IGNORE_INDEX, FramewiseLoss
+    from skgesture._nn._training import IGNORE_INDEX, FramewiseLoss
 
     logits = torch.randn(2, 5, 3, requires_grad=True)
     target = torch.full((2, 5), IGNORE_INDEX)

@@ -17,9 +17,9 @@ torch = pytest.importorskip("torch")
 from sklearn.base import clone  # noqa: E402
 
 from skgesture import BiLSTMTagger, SequenceTagger  # noqa: E402
-from skgesture._bilstm import _SequenceHoldout  # noqa: E402
-from skgesture._networks import FramewiseLoss, held_out_sequences  # noqa: E402
-from skgesture._tagger import _HoldOutSequences  # noqa: E402
+from skgesture._nn._sequence_net import _HoldOutSequences  # noqa: E402
+from skgesture._nn._training import FramewiseLoss, held_out_sequences  # noqa: E402
+from skgesture._taggers._bilstm import _SequenceHoldout  # noqa: E402
 
 TAGGERS = {
     "bilstm": lambda **p: BiLSTMTagger(hidden_sizes=(4,), max_epochs=2, **p),

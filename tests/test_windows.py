@@ -7,7 +7,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.utils._param_validation import InvalidParameterError
 
 from skgesture import DynamicPoseWindow
-from skgesture._multiscale import period_windows
+from skgesture._multiscale._rules import period_windows
 from skgesture._windows import dynamic_poses
 from skgesture.utils._resize import resize_frames
 

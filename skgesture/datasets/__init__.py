@@ -20,7 +20,6 @@ from skgesture.datasets._chalearn import (
 )
 from skgesture.datasets._others import (
     MSR_ACTION3D_ACTION_NAMES,
-    MSR_ACTION3D_TO_KINECT_V1,
     MSRC12_GESTURE_NAMES,
     UTKINECT_ACTION_NAMES,
     load_msr_action3d,
@@ -35,6 +34,7 @@ from skgesture.datasets._recordings import (
     write_intervals,
 )
 from skgesture.datasets._synthetic import make_gesture_streams
+from skgesture.layouts import MSR_ACTION3D_TO_KINECT_V1
 
 __all__ = [
     "CHALEARN_GESTURE_NAMES",

@@ -30,7 +30,7 @@ from skgesture.datasets._base import (
     _sort_and_label,
     _warn,
 )
-from skgesture.layouts import N_COORDS, N_KINECT_JOINTS
+from skgesture.layouts import MSR_ACTION3D_TO_KINECT_V1, N_COORDS, N_KINECT_JOINTS
 
 __all__ = [
     "MSR_ACTION3D_TO_KINECT_V1",
@@ -509,21 +509,6 @@ def load_utkinect(path, *, labels="original", verbose=0):
 # MSR Action3D
 # ----------------------------------------------------------------------------
 
-# For each Kinect v1 NUI joint (HipCenter, Spine, ShoulderCenter, Head,
-# ShoulderLeft, ElbowLeft, WristLeft, HandLeft, ShoulderRight, ElbowRight,
-# WristRight, HandRight, HipLeft, KneeLeft, AnkleLeft, FootLeft, HipRight,
-# KneeRight, AnkleRight, FootRight) the 0-based index of the same joint in the MSR
-# Action3D file order (data PROVENANCE: 1 left shoulder, 2 right shoulder,
-# 3 shoulder centre, 4 spine, 5 left hip, 6 right hip, 7 hip centre, 8/9 elbows,
-# 10/11 wrists, 12/13 hands, 14/15 knees, 16/17 ankles, 18/19 feet, 20 head).
-# Use as ``X_kinect = X_msr[:, MSR_ACTION3D_TO_KINECT_V1]``.
-MSR_ACTION3D_TO_KINECT_V1 = (
-    6, 3, 2, 19,
-    0, 7, 9, 11,
-    1, 8, 10, 12,
-    4, 13, 15, 17,
-    5, 14, 16, 18,
-)  # fmt: skip
 MSR_ACTION3D_ACTION_NAMES = (
     "high arm wave", "horizontal arm wave", "hammer", "hand catch",
     "forward punch", "high throw", "draw x", "draw tick", "draw circle",

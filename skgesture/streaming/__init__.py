@@ -18,6 +18,11 @@ See ``docs/streaming.md`` for the timing and the differences from offline
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from skgesture.layouts import (
+    AZURE_KINECT_JOINTS,
+    KINECT_V2_JOINTS,
+    MEDIAPIPE_POSE_LANDMARKS,
+)
 from skgesture.streaming._actions import (
     ActionDecision,
     ActionMap,
@@ -29,9 +34,6 @@ from skgesture.streaming._actions import (
     SimulatedRobot,
 )
 from skgesture.streaming._adapters import (
-    AZURE_KINECT_JOINTS,
-    KINECT_V2_JOINTS,
-    MEDIAPIPE_POSE_LANDMARKS,
     AzureKinectAdapter,
     KinectV1Adapter,
     KinectV2Adapter,

@@ -24,7 +24,13 @@ from numbers import Real
 
 import numpy as np
 
-from skgesture.layouts import KINECT_V1, N_COORDS
+from skgesture.layouts import (
+    AZURE_KINECT_JOINTS,
+    KINECT_V1,
+    KINECT_V2_JOINTS,
+    MEDIAPIPE_POSE_LANDMARKS,
+    N_COORDS,
+)
 from skgesture.utils._validation import missing_frames
 
 __all__ = [
@@ -42,39 +48,6 @@ __all__ = [
     "ReplaySource",
 ]
 
-# Kinect for Windows SDK 2.0 ``JointType`` order (25 joints).
-KINECT_V2_JOINTS = (
-    "SpineBase", "SpineMid", "Neck", "Head",
-    "ShoulderLeft", "ElbowLeft", "WristLeft", "HandLeft",
-    "ShoulderRight", "ElbowRight", "WristRight", "HandRight",
-    "HipLeft", "KneeLeft", "AnkleLeft", "FootLeft",
-    "HipRight", "KneeRight", "AnkleRight", "FootRight",
-    "SpineShoulder", "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight",
-)  # fmt: skip
-
-# Azure Kinect Body Tracking SDK ``k4abt_joint_id_t`` order (32 joints).
-AZURE_KINECT_JOINTS = (
-    "PELVIS", "SPINE_NAVEL", "SPINE_CHEST", "NECK",
-    "CLAVICLE_LEFT", "SHOULDER_LEFT", "ELBOW_LEFT", "WRIST_LEFT",
-    "HAND_LEFT", "HANDTIP_LEFT", "THUMB_LEFT",
-    "CLAVICLE_RIGHT", "SHOULDER_RIGHT", "ELBOW_RIGHT", "WRIST_RIGHT",
-    "HAND_RIGHT", "HANDTIP_RIGHT", "THUMB_RIGHT",
-    "HIP_LEFT", "KNEE_LEFT", "ANKLE_LEFT", "FOOT_LEFT",
-    "HIP_RIGHT", "KNEE_RIGHT", "ANKLE_RIGHT", "FOOT_RIGHT",
-    "HEAD", "NOSE", "EYE_LEFT", "EAR_LEFT", "EYE_RIGHT", "EAR_RIGHT",
-)  # fmt: skip
-
-# MediaPipe Pose (BlazePose) landmark order (33 landmarks).
-MEDIAPIPE_POSE_LANDMARKS = (
-    "nose", "left_eye_inner", "left_eye", "left_eye_outer",
-    "right_eye_inner", "right_eye", "right_eye_outer", "left_ear", "right_ear",
-    "mouth_left", "mouth_right", "left_shoulder", "right_shoulder",
-    "left_elbow", "right_elbow", "left_wrist", "right_wrist",
-    "left_pinky", "right_pinky", "left_index", "right_index",
-    "left_thumb", "right_thumb", "left_hip", "right_hip",
-    "left_knee", "right_knee", "left_ankle", "right_ankle",
-    "left_heel", "right_heel", "left_foot_index", "right_foot_index",
-)  # fmt: skip
 
 _LIMB_PARTS = ("Shoulder", "Elbow", "Wrist", "Hand", "Hip", "Knee", "Ankle", "Foot")
 
@@ -441,7 +414,7 @@ class MSRAction3DAdapter(SkeletonAdapter):
     name = "msr_action3d"
 
     def _convert(self, X):
-        from skgesture.datasets import MSR_ACTION3D_TO_KINECT_V1
+        from skgesture.layouts import MSR_ACTION3D_TO_KINECT_V1
 
         return X[:, list(MSR_ACTION3D_TO_KINECT_V1)]
 

@@ -17,12 +17,8 @@ from numbers import Integral
 
 import numpy as np
 
-from skgesture._incremental import (
-    DEFAULT_MAX_BACKFILL,
-    DEFAULT_MAX_PERIOD,
-    _concat_rows,
-    stream_frames,
-)
+from skgesture._stream import DEFAULT_MAX_BACKFILL, DEFAULT_MAX_PERIOD, stream_frames
+from skgesture.utils._buffers import _concat_rows
 
 __all__ = ["GestureEvent", "StreamingRecognizer"]
 
@@ -424,7 +420,7 @@ class StreamingRecognizer:
                 )
 
     def _threads(self):
-        from skgesture._networks import torch_threads
+        from skgesture._nn._training import torch_threads
 
         return torch_threads(self.n_threads)
 

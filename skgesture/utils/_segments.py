@@ -271,3 +271,21 @@ def remove_short_runs(labels, min_length, *, rest=0):
         if v != rest and e - s < min_length:
             out[s:e] = rest
     return out
+
+
+def _chunks(n_frames, window, overlap):
+    """``(start, end)`` of the inference chunks of a sequence (docs/method.md §7.4).
+
+    Without overlap: consecutive non-overlapping chunks, the last one shorter.
+    With overlap: full windows every ``window // 2`` frames plus one ending at
+    the last frame, so that every frame is covered (one chunk if the sequence
+    is shorter than a window).
+    """
+    if not overlap or n_frames <= window:
+        starts = np.arange(0, n_frames, window)
+        return [(int(s), int(min(s + window, n_frames))) for s in starts]
+    step = max(window // 2, 1)
+    starts = list(range(0, n_frames - window + 1, step))
+    if starts[-1] != n_frames - window:
+        starts.append(n_frames - window)
+    return [(s, s + window) for s in starts]

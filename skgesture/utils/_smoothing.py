@@ -4,9 +4,11 @@
 
 from functools import lru_cache
 from math import ceil, floor, isfinite
-from numbers import Real
+from numbers import Integral, Real
 
 import numpy as np
+
+from skgesture.utils._buffers import RowBuffer
 
 __all__ = ["loess_smooth", "loess_kernel"]
 
@@ -225,3 +227,208 @@ def loess_smooth(y, span=DEFAULT_SPAN, *, axis=0, method="loess"):
 
     out = out.reshape(moved.shape).astype(dtype, copy=False)
     return np.moveaxis(out, 0, axis)
+
+
+def check_stream_span(span, owner):
+    """Odd integer span of a streamed loess; fractions need the whole length."""
+    if isinstance(span, Real) and not isinstance(span, Integral) and 0 < span < 1:
+        raise ValueError(
+            f"{owner}={span!r} is a fraction of the sequence length, which a "
+            f"stream does not know in advance; use an integer span"
+        )
+    return len(loess_kernel(span))
+
+
+class LoessStepper:
+    """MATLAB ``smooth(y, span, 'loess')`` of a series that grows at its end.
+
+    The smoothed value of row ``u`` needs rows up to ``u + h`` (``h = (span -
+    1) / 2``): it is the interior kernel of :func:`loess_kernel`, applied in
+    the accumulation order of :func:`loess_smooth` (bit-identical values). The
+    first ``h`` rows use MATLAB's end-point fits once ``2 h`` rows are known,
+    the last ``h`` rows at :meth:`flush`, both through :func:`loess_smooth`
+    itself.
+
+    Parameters
+    ----------
+    span : int
+        Loess span in frames (a fraction is refused: see
+        :func:`check_stream_span`).
+    n_tracks : int
+        Columns smoothed independently.
+    owner : str, default="smooth_span"
+        Parameter name for error messages.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.utils._smoothing import LoessStepper
+    >>> from skgesture.utils._smoothing import loess_smooth
+    >>> y = np.sin(np.arange(40.0))[:, None]
+    >>> st = LoessStepper(7, 1)
+    >>> parts = [st.step(y[i : i + 1], np.array([i]))[1] for i in range(40)]
+    >>> out = np.concatenate(parts + [st.flush(39)[1]])
+    >>> bool(np.array_equal(out, loess_smooth(y, 7)))
+    True
+    """
+
+    def __init__(self, span, n_tracks, owner="smooth_span"):
+        self.span = check_stream_span(span, owner)
+        self.kernel = loess_kernel(self.span)
+        self.taps = self.kernel[1:-1].tolist()
+        self.h = (self.span - 1) // 2
+        self.n_tracks = n_tracks
+        self.buf = RowBuffer((n_tracks,), capacity=4 * self.span + 16)
+        self.n_out = 0
+
+    def step(self, values, times):
+        """Append raw rows; return ``(first, smoothed, times)`` of the rows that
+        became final (``first`` is the index of the first one)."""
+        self.buf.append(values, None, times)
+        return self._advance()
+
+    def _advance(self):
+        h, n, lo0 = self.h, self.buf.stop, self.n_out
+        parts, times = [], []
+        if h == 0:
+            if n > lo0:
+                parts.append(self.buf.data(lo0, n).copy())
+                times.append(self.buf.time(lo0, n).copy())
+                self.n_out = n
+        else:
+            if self.n_out == 0 and n >= 2 * h:
+                # MATLAB's end-point fits on the first 2h rows, as loess_smooth.
+                head = loess_smooth(self.buf.data(0, 2 * h), self.span, axis=0)[:h]
+                parts.append(head)
+                times.append(np.full(h, self.buf.time(2 * h - 1, 2 * h)[0]))
+                self.n_out = h
+            lo, stop = self.n_out, n - h
+            if self.n_out >= h and stop > lo:
+                m = stop - lo
+                window = self.buf.data(lo - h, stop + h)
+                # Same accumulation order as loess_smooth (bitwise equal values).
+                if m == 1 and self.n_tracks == 1:  # one new frame: Python floats
+                    value = 0.0
+                    for k, w in zip(self.taps, window[1:-1, 0].tolist()):
+                        value += k * w
+                    acc = np.array([[value]])
+                else:
+                    acc = np.zeros((m, self.n_tracks))
+                    for k in range(1, self.span - 1):
+                        acc += self.kernel[k] * window[k : k + m]
+                parts.append(acc)
+                times.append(self.buf.time(lo + h, stop + h).copy())
+                self.n_out = stop
+        # Keep h rows before the next one to smooth and span rows for the end
+        # fits of flush (everything while fewer than span rows are known).
+        self.buf.drop(max(0, min(self.n_out - h, n - self.span)))
+        if not parts:
+            return lo0, np.empty((0, self.n_tracks)), np.zeros(0, dtype=np.int64)
+        return lo0, np.concatenate(parts), np.concatenate(times)
+
+    def flush(self, now):
+        """The remaining rows, with the end-point fits; their time is ``now``."""
+        n, lo = self.buf.stop, self.n_out
+        if n <= lo:
+            return lo, np.empty((0, self.n_tracks)), np.zeros(0, dtype=np.int64)
+        first = self.buf.start
+        smoothed = loess_smooth(self.buf.data(first, n), self.span, axis=0)
+        self.n_out = n
+        return lo, smoothed[lo - first :], np.full(n - lo, now, dtype=np.int64)
+
+    def held(self):
+        """Rows currently held."""
+        return len(self.buf)
+
+
+class MeanStepper:
+    """``smooth_proba(..., smoothing="mean")`` of a series that grows at its end.
+
+    The centred moving average of ``scipy.ndimage.uniform_filter1d`` (size
+    ``int(span)``, edges replicated), computed by scipy's own recurrence (a
+    running sum, one value in and one out per row, divided by the size), so
+    the values equal the offline ones. The value of row ``u`` needs rows up
+    to ``u + h`` (``h = size - size // 2 - 1``); the last rows come at
+    :meth:`flush`, with the last row replicated. Same interface as
+    :class:`LoessStepper`.
+
+    Parameters
+    ----------
+    span : int or float
+        Window in frames (``int(span)``; 1 or less: no smoothing).
+    n_tracks : int
+        Columns smoothed independently.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.ndimage import uniform_filter1d
+    >>> from skgesture.utils._smoothing import MeanStepper
+    >>> y = np.sin(np.arange(30.0))[:, None]
+    >>> st = MeanStepper(5, 1)
+    >>> parts = [st.step(y[i : i + 1], np.array([i]))[1] for i in range(30)]
+    >>> out = np.concatenate(parts + [st.flush(29)[1]])
+    >>> ref = uniform_filter1d(y, 5, axis=0, mode="nearest")
+    >>> bool(np.allclose(out, ref, rtol=0, atol=1e-12))
+    True
+    """
+
+    def __init__(self, span, n_tracks):
+        self.size = max(int(span), 1)
+        self.left = self.size // 2
+        self.h = self.size - self.left - 1
+        self.n_tracks = n_tracks
+        self.buf = RowBuffer((n_tracks,), capacity=2 * self.size + 16)
+        self.n_out = 0
+        self.total = None  # running sum of the current window
+
+    def _ext(self, j, stop):
+        """Row ``j - left`` of the series, end rows replicated (``"nearest"``)."""
+        k = min(max(j - self.left, 0), stop - 1)
+        return self.buf.data(k, k + 1)[0]
+
+    def step(self, values, times):
+        """Append raw rows; return ``(first, smoothed, times)`` of the final ones."""
+        self.buf.append(values, None, times)
+        return self._advance(self.buf.stop - self.h, self.buf.stop, final=False)
+
+    def _advance(self, stop, n, final, now=None):
+        lo0 = self.n_out
+        if self.size == 1:
+            out = self.buf.data(lo0, n).copy()
+            times = self.buf.time(lo0, n).copy()
+            self.n_out = n
+            self.buf.drop(n)
+            return lo0, out, times
+        rows, times = [], []
+        size = self.size
+        for u in range(lo0, stop):
+            if u == 0:
+                total = np.zeros(self.n_tracks)
+                for j in range(size):
+                    total += self._ext(j, n)
+                self.total = total
+            else:
+                self.total = self.total + (
+                    self._ext(u - 1 + size, n) - self._ext(u - 1, n)
+                )
+            rows.append(self.total / size)
+            if final:
+                times.append(now)
+            else:
+                last = min(u + self.h, n - 1)
+                times.append(self.buf.time(last, last + 1)[0])
+            self.n_out = u + 1
+        self.buf.drop(max(self.n_out - 1 - self.left, 0))
+        if not rows:
+            return lo0, np.empty((0, self.n_tracks)), np.zeros(0, dtype=np.int64)
+        return lo0, np.array(rows), np.asarray(times, dtype=np.int64)
+
+    def flush(self, now):
+        """The remaining rows (the last row replicated); their time is ``now``."""
+        n = self.buf.stop
+        return self._advance(n, n, final=True, now=now)
+
+    def held(self):
+        """Rows currently held."""
+        return len(self.buf)

@@ -8,6 +8,7 @@ the frame and the expected shape, so a user can find the bad recording.
 # SPDX-License-Identifier: BSD-3-Clause
 
 import numbers
+import re
 
 import numpy as np
 from sklearn.utils._param_validation import Options
@@ -506,3 +507,28 @@ def check_skeletons(X, *, estimator=None, reset=True, name="X"):
         max_abs=MAX_COORDINATE,
         name=name,
     )
+
+
+def check_stream_frames(desc, frames, first):
+    """Validate pushed raw frames exactly as the stage's offline ``transform`` does.
+
+    ``desc`` is the first stage: a :class:`~skgesture.PoseDescriptor` (its own
+    ``_validate``) or any other stage reading raw skeletons, such as
+    :class:`~skgesture.JointFeatures` (``check_skeletons``, the rule both
+    share). Returns the frames as float64 ``(n, 20, 3)``; a bad frame raises a
+    ``ValueError`` naming its index in the stream.
+    """
+    if isinstance(frames, np.ma.MaskedArray):
+        frames = np.ma.filled(np.ma.asarray(frames, dtype=float), np.nan)
+    try:
+        if hasattr(desc, "_validate"):
+            return desc._validate([frames], reset=False)[0]
+        from skgesture.utils._validation import check_skeletons
+
+        return check_skeletons([frames], estimator=desc, reset=False)[0]
+    except ValueError as exc:
+        msg = str(exc)
+        match = re.search(r"at frame (\d+)|\(frame (\d+)\)", msg)
+        k = int(next(g for g in match.groups() if g is not None)) if match else 0
+        msg = re.sub(r"^X\[0\] ", "", msg)
+        raise ValueError(f"frame {first + k} of the stream is invalid: {msg}") from None

@@ -11,8 +11,8 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from skgesture._networks import (
-    _ACTIVATIONS,
+from skgesture._nn._modules import _ACTIVATIONS
+from skgesture._nn._training import (
     SCG_MAX_FAIL,
     TEST_FRACTION,
     TORCH_RNG_LOCK,

@@ -27,6 +27,8 @@ from skorch.dataset import Dataset
 from torch import nn
 from torch.nn import functional as F
 
+from skgesture._nn._modules import MLPModule
+
 __all__ = [
     "FramewiseLoss",
     "FramewiseNetwork",
@@ -48,48 +50,6 @@ TEST_FRACTION = 0.15
 PREDICT_BATCH = 65536
 IGNORE_INDEX = -100  # target of frames a framewise loss leaves out (padding, untracked)
 SMOOTHING_CLAMP = 16.0  # MS-TCN's truncation of the squared log-prob change
-
-_ACTIVATIONS = {
-    "relu": nn.ReLU,
-    "tanh": nn.Tanh,
-    "sigmoid": nn.Sigmoid,
-    "leaky_relu": nn.LeakyReLU,
-}
-
-
-class MLPModule(nn.Module):
-    """Fully connected network returning logits (the loss applies the output map).
-
-    Parameters
-    ----------
-    n_inputs : int
-        Input width.
-    n_outputs : int
-        Output width (1 for a sigmoid output, K for a softmax output).
-    hidden_layer_sizes : tuple of int
-        Width of each hidden layer.
-    activations : tuple of str
-        Activation after each hidden layer (``"relu"``, ``"tanh"``, ...).
-    """
-
-    def __init__(
-        self, n_inputs, n_outputs, hidden_layer_sizes=(100,), activations=("tanh",)
-    ):
-        super().__init__()
-        if len(activations) != len(hidden_layer_sizes):
-            raise ValueError(
-                f"{len(hidden_layer_sizes)} hidden layers but {len(activations)} "
-                f"activations"
-            )
-        layers, width = [], n_inputs
-        for size, act in zip(hidden_layer_sizes, activations):
-            layers += [nn.Linear(width, size), _ACTIVATIONS[act]()]
-            width = size
-        layers.append(nn.Linear(width, n_outputs))
-        self.net = nn.Sequential(*layers)
-
-    def forward(self, X):
-        return self.net(X)
 
 
 class MatlabCrossEntropy(nn.CrossEntropyLoss):
@@ -355,7 +315,7 @@ def held_out_sequences(n_sequences, fraction, seed):
 
     Examples
     --------
-    >>> from skgesture._networks import held_out_sequences
+    >>> from skgesture._nn._training import held_out_sequences
     >>> len(held_out_sequences(10, 0.2, seed=0))
     2
     """

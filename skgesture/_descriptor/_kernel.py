@@ -21,7 +21,7 @@ import math
 import numba
 import numpy as np
 
-from skgesture._descriptor import MIN_NORM
+from skgesture._descriptor._constants import MIN_NORM
 
 TWO_PI_3 = 2.0 * np.pi / 3.0
 BORDER_CODES = {"replicate": 0, "zero": 1, "symmetric": 2}

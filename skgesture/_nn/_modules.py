@@ -24,6 +24,9 @@ __all__ = [
     "frame_probabilities",
 ]
 
+PAPER_MODULE = {"cell": "lstm", "activation": "leaky_relu", "init": "matlab"}
+CPU_HIDDEN_SIZES = (64, 64)
+CPU_DROPOUT = 0.3
 LEAKY_SLOPE = 0.01  # docs/method.md §7.2: LeakyReLU between the paper's BiLSTMs
 KERNEL = 3  # MS-TCN's dilated convolution width
 
@@ -201,3 +204,76 @@ class TemporalConvModule(nn.Module):
             out = stage(F.softmax(out, dim=1))
             outputs.append(out)
         return tuple(o.transpose(1, 2) for o in outputs)
+
+
+_ACTIVATIONS = {
+    "relu": nn.ReLU,
+    "tanh": nn.Tanh,
+    "sigmoid": nn.Sigmoid,
+    "leaky_relu": nn.LeakyReLU,
+}
+
+
+class MLPModule(nn.Module):
+    """Fully connected network returning logits (the loss applies the output map).
+
+    Parameters
+    ----------
+    n_inputs : int
+        Input width.
+    n_outputs : int
+        Output width (1 for a sigmoid output, K for a softmax output).
+    hidden_layer_sizes : tuple of int
+        Width of each hidden layer.
+    activations : tuple of str
+        Activation after each hidden layer (``"relu"``, ``"tanh"``, ...).
+    """
+
+    def __init__(
+        self, n_inputs, n_outputs, hidden_layer_sizes=(100,), activations=("tanh",)
+    ):
+        super().__init__()
+        if len(activations) != len(hidden_layer_sizes):
+            raise ValueError(
+                f"{len(hidden_layer_sizes)} hidden layers but {len(activations)} "
+                f"activations"
+            )
+        layers, width = [], n_inputs
+        for size, act in zip(hidden_layer_sizes, activations):
+            layers += [nn.Linear(width, size), _ACTIVATIONS[act]()]
+            width = size
+        layers.append(nn.Linear(width, n_outputs))
+        self.net = nn.Sequential(*layers)
+
+    def forward(self, X):
+        return self.net(X)
+
+
+class _BiLSTMModule(RecurrentTaggerModule):
+    """Method C's network as saved before it became a
+    :class:`~skgesture._nn._modules.RecurrentTaggerModule`; kept so that those
+    files load (their ``lstms`` are the ``layers``). New taggers use
+    ``RecurrentTaggerModule(**PAPER_MODULE)`` directly."""
+
+    def __init__(
+        self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES, dropout=CPU_DROPOUT
+    ):
+        super().__init__(
+            n_inputs, n_outputs, hidden_sizes, dropout=dropout, **PAPER_MODULE
+        )
+
+    def __setstate__(self, state):  # a pickled (joblib) tagger
+        modules = state.get("_modules", {})
+        if "lstms" in modules:
+            state["_modules"] = type(modules)(
+                ("layers" if k == "lstms" else k, v) for k, v in modules.items()
+            )
+            state.setdefault("cell", "lstm")
+        super().__setstate__(state)
+
+    def load_state_dict(self, state_dict, *args, **kwargs):  # a model file
+        state_dict = {
+            ("layers." + k[len("lstms.") :] if k.startswith("lstms.") else k): v
+            for k, v in state_dict.items()
+        }
+        return super().load_state_dict(state_dict, *args, **kwargs)

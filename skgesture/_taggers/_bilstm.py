@@ -3,9 +3,9 @@
 What is Method C's own lives here: the paper's training windows (the sampler),
 its SGD optimiser and step schedule, and its chunked inference. The rest is
 shared with the other taggers: the network is a
-:class:`~skgesture._modules.RecurrentTaggerModule`, the training loop is
-:class:`~skgesture._networks.FramewiseNetwork`'s, and input checks, untracked
-rows and the decoding come from :class:`~skgesture._tagger._BaseTagger`.
+:class:`~skgesture._nn._modules.RecurrentTaggerModule`, the training loop is
+:class:`~skgesture._nn._training.FramewiseNetwork`'s, and input checks, untracked
+rows and the decoding come from :class:`~skgesture._taggers._base._BaseTagger`.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -19,17 +19,23 @@ from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 from skorch.callbacks import LRScheduler
 
-from skgesture._decoding import smooth_proba
-from skgesture._modules import RecurrentTaggerModule, frame_probabilities
-from skgesture._networks import (  # noqa: F401 - _silent: sink of old pickles
+from skgesture._nn._modules import (
+    CPU_DROPOUT,
+    CPU_HIDDEN_SIZES,
+    PAPER_MODULE,
+    RecurrentTaggerModule,
+    frame_probabilities,
+)
+from skgesture._nn._training import (
     IGNORE_INDEX,
     FramewiseLoss,
     FramewiseNetwork,
-    _silent,
     held_out_sequences,
     seed_from,
 )
-from skgesture._tagger import _BaseTagger, _rest_where
+from skgesture._taggers._base import _BaseTagger, _rest_where
+from skgesture._taggers._decoding import smooth_proba
+from skgesture.utils._segments import _chunks
 from skgesture.utils._validation import SequenceOf
 
 __all__ = ["BiLSTMTagger", "sample_windows"]
@@ -40,7 +46,6 @@ REST_STEP = 5
 GESTURE_STEP = 2
 # docs/method.md §7.2: network, a RecurrentTaggerModule of BiLSTMs with LeakyReLU
 # (0.01) and dropout between them, initialised as MATLAB does
-PAPER_MODULE = {"cell": "lstm", "activation": "leaky_relu", "init": "matlab"}
 PAPER_HIDDEN_SIZES = (1024, 1024, 512)
 PAPER_DROPOUT = 0.6
 # docs/method.md §7.3: optimiser and schedule
@@ -55,8 +60,6 @@ PAPER_MAX_EPOCHS = 150
 MIN_RUN = 15
 SMOOTH_SPAN = 15
 # CPU-sized default network (measured in the BiLSTMTagger Notes)
-CPU_HIDDEN_SIZES = (64, 64)
-CPU_DROPOUT = 0.3
 CPU_MAX_EPOCHS = 40
 
 VALIDATION_FRACTION = 0.1
@@ -92,7 +95,7 @@ def sample_windows(y, window=WINDOW, rest_step=REST_STEP, gesture_step=GESTURE_S
     Examples
     --------
     >>> import numpy as np
-    >>> from skgesture._bilstm import sample_windows
+    >>> from skgesture._taggers._bilstm import sample_windows
     >>> y = np.r_[np.zeros(20, int), np.ones(10, int), np.zeros(20, int)]
     >>> sample_windows(y).tolist()
     [0, 5, 10, 15, 17, 19, 21, 23, 25, 27, 29, 31, 36]
@@ -136,24 +139,6 @@ def _training_windows(X, y, window, rest_step, gesture_step):
     return np.concatenate(Xw), np.concatenate(yw), np.concatenate(seq)
 
 
-def _chunks(n_frames, window, overlap):
-    """``(start, end)`` of the inference chunks of a sequence (docs/method.md §7.4).
-
-    Without overlap: consecutive non-overlapping chunks, the last one shorter.
-    With overlap: full windows every ``window // 2`` frames plus one ending at
-    the last frame, so that every frame is covered (one chunk if the sequence
-    is shorter than a window).
-    """
-    if not overlap or n_frames <= window:
-        starts = np.arange(0, n_frames, window)
-        return [(int(s), int(min(s + window, n_frames))) for s in starts]
-    step = max(window // 2, 1)
-    starts = list(range(0, n_frames - window + 1, step))
-    if starts[-1] != n_frames - window:
-        starts.append(n_frames - window)
-    return [(s, s + window) for s in starts]
-
-
 def _predict_chunks(module, X, window, overlap, n_classes):
     """Per-frame softmax probabilities of ``module`` on chunks of every sequence.
 
@@ -177,39 +162,9 @@ def _predict_chunks(module, X, window, overlap, n_classes):
     return [s / c for s, c in zip(sums, counts)]
 
 
-class _BiLSTMModule(RecurrentTaggerModule):
-    """Method C's network as saved before it became a
-    :class:`~skgesture._modules.RecurrentTaggerModule`; kept so that those
-    files load (their ``lstms`` are the ``layers``). New taggers use
-    ``RecurrentTaggerModule(**PAPER_MODULE)`` directly."""
-
-    def __init__(
-        self, n_inputs, n_outputs, hidden_sizes=CPU_HIDDEN_SIZES, dropout=CPU_DROPOUT
-    ):
-        super().__init__(
-            n_inputs, n_outputs, hidden_sizes, dropout=dropout, **PAPER_MODULE
-        )
-
-    def __setstate__(self, state):  # a pickled (joblib) tagger
-        modules = state.get("_modules", {})
-        if "lstms" in modules:
-            state["_modules"] = type(modules)(
-                ("layers" if k == "lstms" else k, v) for k, v in modules.items()
-            )
-            state.setdefault("cell", "lstm")
-        super().__setstate__(state)
-
-    def load_state_dict(self, state_dict, *args, **kwargs):  # a model file
-        state_dict = {
-            ("layers." + k[len("lstms.") :] if k.startswith("lstms.") else k): v
-            for k, v in state_dict.items()
-        }
-        return super().load_state_dict(state_dict, *args, **kwargs)
-
-
 class _StepCrossEntropy(FramewiseLoss):
     """Method C's loss as saved before it became a
-    :class:`~skgesture._networks.FramewiseLoss`; kept so that those files
+    :class:`~skgesture._nn._training.FramewiseLoss`; kept so that those files
     load."""
 
     def __setstate__(self, state):
@@ -685,7 +640,7 @@ class BiLSTMTagger(_BaseTagger):
         ]
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
-    # The state (skgesture/_incremental.py, TaggerStream) runs the network on
+    # The state (skgesture/_taggers/_stream.py, TaggerStream) runs the network on
     # the chunks of predict_proba as they complete and applies the same loess,
     # rest rule and minimum run.
 
@@ -702,7 +657,7 @@ class BiLSTMTagger(_BaseTagger):
         object
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._incremental import TaggerStream
+        from skgesture._taggers._stream import TaggerStream
 
         check_is_fitted(self)
         return TaggerStream(self)
@@ -755,7 +710,7 @@ class BiLSTMTagger(_BaseTagger):
 
         ``(smooth_span - 1) // 2 + window`` (17 with the defaults).
         """
-        from skgesture._incremental import check_stream_span
+        from skgesture.utils._smoothing import check_stream_span
 
         return (check_stream_span(self.smooth_span, "smooth_span") - 1) // 2 + int(
             self.window

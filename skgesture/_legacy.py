@@ -1,0 +1,85 @@
+"""Import paths of skgesture 0.1, kept for one release (to be removed in 0.3).
+
+Model files and joblib pickles written by skgesture 0.1 name classes by the
+private module that defined them then (``skgesture._tagger.SequenceTagger``,
+``skgesture._networks.MLPModule``, ...). Those modules moved into the
+``skgesture._nn`` and ``skgesture._taggers`` subpackages (docs/design.md,
+"Module map"). This module keeps the old paths importable: an old path is a
+module whose attributes are looked up, in order, in the modules its names went
+to. New files record the new paths (the public names where a class has one).
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import types
+
+# Old module path -> the modules its names moved to, searched in order.
+MOVED = {
+    "skgesture._incremental": (
+        "skgesture._stream",
+        "skgesture.utils._buffers",
+        "skgesture.utils._smoothing",
+    ),
+    "skgesture._tagger": (
+        "skgesture._taggers._base",
+        "skgesture._taggers._sequence",
+        "skgesture._taggers._voting",
+        "skgesture._nn._sequence_net",
+    ),
+    "skgesture._bilstm": ("skgesture._taggers._bilstm", "skgesture._nn._modules"),
+    "skgesture._networks": ("skgesture._nn._training", "skgesture._nn._modules"),
+    "skgesture._modules": ("skgesture._nn._modules",),
+    "skgesture._mlp": ("skgesture._nn._mlp",),
+    "skgesture._decoding": ("skgesture._taggers._decoding",),
+    "skgesture._descriptor_kernel": ("skgesture._descriptor._kernel",),
+}
+
+
+def _lookup(old, name):
+    for target in MOVED[old]:
+        module = importlib.import_module(target)
+        if name in vars(module):
+            return vars(module)[name]
+    raise AttributeError(f"module {old!r} (moved) has no attribute {name!r}")
+
+
+class _MovedModule(types.ModuleType):
+    """An old module path: its attributes are those of the modules it went to."""
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return _lookup(self.__name__, name)
+
+
+class _Loader(importlib.abc.Loader):
+    def create_module(self, spec):
+        return _MovedModule(spec.name)
+
+    def exec_module(self, module):
+        module.__doc__ = (
+            f"Moved in skgesture 0.2 to {', '.join(MOVED[module.__name__])}; "
+            f"kept for files written by 0.1."
+        )
+
+
+class _Finder(importlib.abc.MetaPathFinder):
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname in MOVED:
+            return importlib.util.spec_from_loader(fullname, _Loader())
+        return None
+
+
+def old_paths(cls):
+    """The 0.1 module paths under which ``cls`` was reachable."""
+    return [old for old, new in MOVED.items() if cls.__module__ in new]
+
+
+def install():
+    """Make the old paths importable (idempotent)."""
+    if not any(isinstance(f, _Finder) for f in sys.meta_path):
+        sys.meta_path.append(_Finder())

@@ -1,0 +1,335 @@
+"""The skorch net of the sequence taggers.
+
+Crop datasets, whole-sequence batches, hold-out splits and the learning-rate
+schedule of :class:`~skgesture.SequenceTagger`.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import numpy as np
+import torch
+from skorch.callbacks import GradientNormClipping, LRScheduler
+
+from skgesture._nn._modules import (
+    RecurrentTaggerModule,
+    TemporalConvModule,
+    frame_probabilities,
+)
+from skgesture._nn._training import (
+    IGNORE_INDEX,
+    FramewiseNetwork,
+    held_out_sequences,
+    seed_from,
+)
+
+MIN_SCALE = 1e-6  # a feature with a smaller training std keeps scale 1
+
+
+class _CropData(torch.utils.data.Dataset):
+    """Training sequences from which :class:`_CropBatches` draws random crops.
+
+    Each crop is a random ``crop_length``-frame slice of a random sequence,
+    perturbed by ``augmenter`` (before standardisation, so rotations act on
+    raw xyz triples) and standardised; a shorter sequence is padded, its
+    padding left out of the loss.
+    """
+
+    def __init__(self, X, y, *, crop_length, augmenter, mean, scale, seed):
+        self.X, self.y = X, y
+        self.crop_length = crop_length
+        self.augmenter = augmenter
+        self.mean = mean.astype(np.float32)
+        self.scale = scale.astype(np.float32)
+        self.rng = np.random.RandomState(seed)
+
+    def __len__(self):
+        return len(self.X)
+
+    def __getitem__(self, i):
+        raise TypeError("crops are drawn in batches by _CropBatches")
+
+    def sample(self, batch_size):
+        rng, length = self.rng, self.crop_length
+        xb = np.zeros((batch_size, length, self.mean.size), dtype=np.float32)
+        yb = np.full((batch_size, length), IGNORE_INDEX, dtype=np.int64)
+        for b in range(batch_size):
+            i = rng.randint(len(self.X))
+            x, y = self.X[i], self.y[i]
+            if self.augmenter is not None:
+                # Crop with a margin first, so the time warp has frames to use.
+                margin = int(np.ceil(length * 1.5))
+                if len(x) > margin:
+                    s = rng.randint(len(x) - margin + 1)
+                    x, y = x[s : s + margin], y[s : s + margin]
+                x, y = self.augmenter.augment(x, y, rng)
+            if len(x) > length:
+                s = rng.randint(len(x) - length + 1)
+                x, y = x[s : s + length], y[s : s + length]
+            xb[b, : len(x)] = (x - self.mean) / self.scale
+            yb[b, : len(y)] = y
+        return torch.from_numpy(xb), torch.from_numpy(yb)
+
+
+class _CropBatches:
+    """skorch iterator: ``steps`` batches of random crops per epoch."""
+
+    def __init__(self, dataset, batch_size=32, steps=10, **kwargs):
+        self.dataset = dataset
+        self.batch_size = batch_size
+        self.steps = steps
+
+    def __len__(self):
+        return self.steps
+
+    def __iter__(self):
+        for _ in range(self.steps):
+            yield self.dataset.sample(self.batch_size)
+
+
+class _WholeSequences(torch.utils.data.Dataset):
+    """Held-out sequences, standardised, for the validation loss."""
+
+    def __init__(self, X, y, mean, scale):
+        self.X = [((x - mean) / scale).astype(np.float32) for x in X]
+        self.y = y
+
+    def __len__(self):
+        return len(self.X)
+
+    def __getitem__(self, i):
+        return torch.from_numpy(self.X[i]), torch.from_numpy(self.y[i])
+
+
+class _OneSequenceBatches:
+    """skorch iterator over a :class:`_WholeSequences`, one sequence a batch."""
+
+    def __init__(self, dataset, **kwargs):
+        self.dataset = dataset
+
+    def __len__(self):
+        return len(self.dataset)
+
+    def __iter__(self):
+        for i in range(len(self.dataset)):
+            x, y = self.dataset[i]
+            yield x[None], y[None]
+
+
+class _HoldOutSequences:
+    """skorch ``train_split``: whole sequences held out for validation."""
+
+    def __init__(self, fraction, seed):
+        self.fraction = fraction
+        self.seed = seed
+
+    def __call__(self, dataset, y=None, **kwargs):
+        n = len(dataset.X)
+        held = held_out_sequences(n, self.fraction, self.seed)
+        keep = np.setdiff1d(np.arange(n), held)
+        train = _CropData(
+            [dataset.X[i] for i in keep],
+            [dataset.y[i] for i in keep],
+            crop_length=dataset.crop_length,
+            augmenter=dataset.augmenter,
+            mean=dataset.mean,
+            scale=dataset.scale,
+            seed=self.seed,
+        )
+        valid = _WholeSequences(
+            [dataset.X[i] for i in held],
+            [dataset.y[i] for i in held],
+            dataset.mean,
+            dataset.scale,
+        )
+        return train, valid
+
+
+class WarmupCosine:
+    """Learning-rate factor of step ``k``: linear warm-up, then cosine decay.
+
+    The one-cycle shape (warm-up over ``warmup`` of the ``total`` steps, then
+    a half cosine down to ``final`` of the peak), as a picklable callable for
+    ``torch.optim.lr_scheduler.LambdaLR``; well defined for any ``total >= 1``.
+
+    Examples
+    --------
+    >>> from skgesture._nn._sequence_net import WarmupCosine
+    >>> f = WarmupCosine(10)
+    >>> [round(float(f(k)), 2) for k in (0, 1, 5, 9)]
+    [0.5, 1.0, 0.51, 0.01]
+    """
+
+    def __init__(self, total, warmup=0.1, final=0.01):
+        self.total = max(int(total), 1)
+        self.warmup = max(int(round(warmup * self.total)), 1)
+        self.final = final
+
+    def __call__(self, step):
+        if step < self.warmup:
+            return (step + 1) / (self.warmup + 1)
+        progress = (step - self.warmup) / max(self.total - self.warmup - 1, 1)
+        progress = min(progress, 1.0)
+        return float(
+            self.final + (1 - self.final) * 0.5 * (1 + np.cos(np.pi * progress))
+        )
+
+
+def _module_spec(architecture, hidden_sizes, dropout, tcn_layers, tcn_stages):
+    """Module class and keyword arguments of an ``architecture``."""
+    if architecture == "tcn":
+        return TemporalConvModule, {
+            "channels": int(hidden_sizes[0]),
+            "n_layers": int(tcn_layers),
+            "n_stages": int(tcn_stages),
+            "dropout": float(dropout),
+        }
+    return RecurrentTaggerModule, {
+        "hidden_sizes": tuple(int(h) for h in hidden_sizes),
+        "cell": architecture,
+        "dropout": float(dropout),
+    }
+
+
+class _CropNet(FramewiseNetwork):
+    """The trainable part of :class:`SequenceTagger`, cached by ``fit_cached``.
+
+    Its parameters are the network and training parameters only, so the
+    tagger's decoding parameters never change the cache key. ``fit`` takes
+    float32 sequences and labels encoded as class indices (``IGNORE_INDEX``
+    for frames left out of the loss) and sets ``net_``, ``mean_`` and
+    ``scale_``. The training loop is :class:`FramewiseNetwork`'s; the sampler
+    draws random crops of whole sequences, the optimiser is AdamW with a
+    one-cycle schedule and gradient clipping.
+    """
+
+    def __init__(
+        self,
+        *,
+        n_classes=2,
+        architecture="gru",
+        hidden_sizes=(64, 64),
+        dropout=0.0,
+        tcn_layers=8,
+        tcn_stages=2,
+        smoothing_weight=0.0,
+        crop_length=128,
+        batch_size=32,
+        steps_per_epoch=20,
+        max_epochs=15,
+        learning_rate=3e-3,
+        weight_decay=1e-4,
+        clip_norm=1.0,
+        class_weight=None,
+        augmenter=None,
+        standardize=True,
+        early_stopping=False,
+        validation_fraction=0.15,
+        n_iter_no_change=5,
+        device="cpu",
+        random_state=None,
+        verbose=0,
+    ):
+        self.n_classes = n_classes
+        self.architecture = architecture
+        self.hidden_sizes = hidden_sizes
+        self.dropout = dropout
+        self.tcn_layers = tcn_layers
+        self.tcn_stages = tcn_stages
+        self.smoothing_weight = smoothing_weight
+        self.crop_length = crop_length
+        self.batch_size = batch_size
+        self.steps_per_epoch = steps_per_epoch
+        self.max_epochs = max_epochs
+        self.learning_rate = learning_rate
+        self.weight_decay = weight_decay
+        self.clip_norm = clip_norm
+        self.class_weight = class_weight
+        self.augmenter = augmenter
+        self.standardize = standardize
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.device = device
+        self.random_state = random_state
+        self.verbose = verbose
+
+    def fit(self, X, y):
+        seed = seed_from(self.random_state)
+        frames = np.concatenate(X)
+        if self.standardize:
+            self.mean_ = frames.mean(axis=0).astype(np.float32)
+            std = frames.std(axis=0)
+            self.scale_ = np.where(std < MIN_SCALE, 1.0, std).astype(np.float32)
+        else:
+            self.mean_ = np.zeros(frames.shape[1], dtype=np.float32)
+            self.scale_ = np.ones(frames.shape[1], dtype=np.float32)
+        data = _CropData(
+            X,
+            y,
+            crop_length=self.crop_length,
+            augmenter=self.augmenter,
+            mean=self.mean_,
+            scale=self.scale_,
+            seed=seed,
+        )
+        module, module_kwargs = _module_spec(
+            self.architecture,
+            self.hidden_sizes,
+            self.dropout,
+            self.tcn_layers,
+            self.tcn_stages,
+        )
+        schedule = [
+            (
+                "lr_scheduler",
+                LRScheduler(
+                    policy=torch.optim.lr_scheduler.LambdaLR,
+                    lr_lambda=WarmupCosine(self.max_epochs * self.steps_per_epoch),
+                    step_every="batch",
+                ),
+            ),
+        ]
+        if self.clip_norm is not None:
+            schedule.append(
+                ("clip", GradientNormClipping(gradient_clip_value=self.clip_norm))
+            )
+        self.net_ = self._train(
+            module,
+            data,
+            seed=seed,
+            n_sequences=len(X),
+            train_split=_HoldOutSequences(self.validation_fraction, seed),
+            callbacks=schedule,
+            module_params={
+                "n_inputs": int(frames.shape[1]),
+                "n_outputs": int(self.n_classes),
+                **module_kwargs,
+            },
+            criterion_params={
+                "class_weight": self.class_weight,
+                "smoothing_weight": float(self.smoothing_weight),
+            },
+            optimizer=torch.optim.AdamW,
+            optimizer__weight_decay=self.weight_decay,
+            iterator_train=_CropBatches,
+            iterator_train__steps=self.steps_per_epoch,
+            iterator_valid=_OneSequenceBatches,
+        )
+        return self
+
+
+def predict_whole(module, X, mean, scale, n_classes):
+    """Per-frame softmax probabilities of ``module`` run over whole sequences.
+
+    Sequences of equal length are batched together; the output is float64.
+    """
+    module.eval()
+    out = [None] * len(X)
+    by_length = {}
+    for i, x in enumerate(X):
+        by_length.setdefault(len(x), []).append(i)
+    for idx in by_length.values():
+        xb = np.stack([(X[i] - mean) / scale for i in idx]).astype(np.float32)
+        for i, p in zip(idx, frame_probabilities(module, xb)):
+            out[i] = p.reshape(len(X[i]), n_classes)
+    return out

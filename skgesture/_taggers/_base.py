@@ -1,0 +1,355 @@
+"""Framewise sequence taggers: the shared base, SequenceTagger and VotingTagger.
+
+:class:`_BaseTagger` holds what every tagger shares: label encoding and input
+checks in ``fit``, the network cached by ``memory`` (decision parameters never
+retrain it), untracked frames forced to rest, and one decoding path
+(:func:`skgesture._taggers._decoding.decode`). :class:`~skgesture.BiLSTMTagger`
+(Method C) and :class:`SequenceTagger` (the recommended model) differ only in
+the network they train and how they run it.
+
+:class:`SequenceTagger` trains on random crops of whole sequences with AdamW,
+a one-cycle schedule, gradient clipping, class weights, augmentation and,
+optionally, early stopping on held-out whole sequences, all through one skorch
+``NeuralNet``; it predicts over whole sequences.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import warnings
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils._param_validation import Interval, StrOptions
+from sklearn.utils.validation import check_is_fitted
+
+from skgesture._nn._training import (
+    IGNORE_INDEX,
+    fit_cached,
+    torch_threads,
+)
+from skgesture._taggers._decoding import SMOOTHINGS, decode, segments_with_confidence
+from skgesture.utils._validation import (
+    check_sequence_labels,
+    check_sequences,
+    untracked_rows,
+)
+
+DEFAULT_STREAM_PAST = 32  # streaming: frames of window before a frame
+DEFAULT_STREAM_FUTURE = 8  # and after it (docs/streaming.md)
+
+
+# -- training data: random crops of whole sequences ----------------------------
+
+
+# -- the shared base -----------------------------------------------------------
+
+
+_DECODING_CONSTRAINTS = {
+    "smooth_span": [Interval(Real, 0, None, closed="neither")],
+    "smoothing": [StrOptions(SMOOTHINGS)],
+    "min_run": [Interval(Integral, 1, None, closed="left")],
+    "max_gap": [Interval(Integral, 0, None, closed="left")],
+}
+
+_STREAM_CONSTRAINTS = {
+    "stream_past": [Interval(Integral, 0, None, closed="left")],
+    "stream_future": [Interval(Integral, 0, None, closed="left")],
+}
+
+
+class _BaseTagger(ClassifierMixin, BaseEstimator):
+    """Per-frame classifier of whole sequences, with one decoding path.
+
+    Subclasses implement ``_network(n_classes)`` (an unfitted estimator whose
+    ``fit(X, y_idx)`` trains the network; cached by ``memory``),
+    ``_adopt(fitted)`` (copies its fitted state) and ``_raw_proba(X)``, and
+    have the parameters ``smooth_span``, ``smoothing``, ``min_run``,
+    ``max_gap``, ``memory`` and ``n_threads`` (or class attributes of these
+    names, for rules a tagger fixes).
+
+    Untracked rows (those of :func:`untracked_rows`: the masked rows of a
+    ``numpy.ma.MaskedArray``, the all-zero rows of a plain array) are rest by
+    construction: certain rest in ``predict_proba``, and rest in the labels,
+    set after the smoothing (so they do not change the smoothed scores of
+    their tracked neighbours) and before the ``min_run`` filter.
+    """
+
+    def _validate_fit(self, X, y, *, ignore_untracked=True):
+        """Checked sequences, labels encoded as class indices, and classes.
+
+        With ``ignore_untracked`` the labels of untracked rows are
+        ``IGNORE_INDEX``: lost tracking teaches nothing.
+        """
+        data = check_sequences(X, ndim=2, estimator=self, reset=True)
+        y = check_sequence_labels(y, data)
+        classes, y_idx = np.unique(np.concatenate(y), return_inverse=True)
+        if classes[0] != 0:
+            raise ValueError(
+                "y has no rest frame (label 0): the tagger learns gestures against "
+                f"rest, got labels {classes.tolist()}"
+            )
+        if len(classes) < 2:
+            raise ValueError(
+                "y has no gesture frame (every label is 0): the tagger needs "
+                "labels 1..K as well as rest"
+            )
+        y_idx = np.split(y_idx.astype(np.int64), np.cumsum([len(v) for v in y])[:-1])
+        if ignore_untracked:
+            for lab, rows in zip(y_idx, _untracked(X, data)):
+                lab[rows] = IGNORE_INDEX
+        return data, y_idx, classes
+
+    def _fit_network(self, X, y_idx, classes):
+        network = self._network(len(classes))
+        with torch_threads(self.n_threads):
+            fitted = fit_cached(self.memory, network, X, y_idx)
+        self.classes_ = classes
+        self._adopt(fitted)
+        return self
+
+    def _proba(self, X):
+        """The network's probabilities and the untracked rows of every sequence."""
+        check_is_fitted(self)
+        data = check_sequences(X, ndim=2, estimator=self, reset=False)
+        with torch_threads(self.n_threads):
+            proba = self._raw_proba(data)
+        return proba, _untracked(X, data)
+
+    def predict_proba(self, X):
+        """Raw per-frame class probabilities (before smoothing).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features; any length >= 1.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i, n_classes)
+            Rows sum to 1; columns in ``classes_`` order. An untracked row
+            (masked, or all zero) is rest with probability 1.
+        """
+        proba, untracked = self._proba(X)
+        return [_rest_where(p, rows) for p, rows in zip(proba, untracked)]
+
+    def predict(self, X):
+        """Per-frame labels.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_frames_i,)
+            Labels from ``classes_`` after the decoding rules; untracked
+            frames are rest (0).
+        """
+        proba, untracked = self._proba(X)
+        return [self._decode(p, rows) for p, rows in zip(proba, untracked)]
+
+    def predict_segments(self, X):
+        """Gesture instances with their confidence.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+
+        Returns
+        -------
+        list of ndarray of shape (n_segments_i, 4)
+            Rows ``(class, start, end, confidence)``, 0-based, ``end``
+            exclusive; the confidence is the mean raw probability of the class
+            over the run.
+        """
+        proba, untracked = self._proba(X)
+        return [
+            segments_with_confidence(self._decode(p, rows), p, self.classes_)
+            for p, rows in zip(proba, untracked)
+        ]
+
+    def score(self, X, y, sample_weight=None):
+        """Mean official ChaLearn 2014 Jaccard index.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features.
+        y : list of ndarray of shape (n_frames_i,)
+            True per-frame labels.
+        sample_weight : None
+            Not supported.
+
+        Returns
+        -------
+        float
+            Mean Jaccard index over the sequences.
+
+        Warns
+        -----
+        UserWarning
+            If ``y`` holds a class never seen in ``fit``: the tagger cannot
+            predict it, so its Jaccard index is 0.
+        """
+        from skgesture.metrics import jaccard_index
+
+        check_is_fitted(self)
+        unseen = np.setdiff1d(
+            np.unique(np.concatenate([np.ravel(v) for v in y])), self.classes_
+        )
+        if unseen.size:
+            warnings.warn(
+                f"y holds classes {unseen.tolist()} never seen in fit (classes_ "
+                f"= {self.classes_.tolist()}): their Jaccard index is 0",
+                UserWarning,
+                stacklevel=2,
+            )
+        return jaccard_index(y, self.predict(X))
+
+    def _decode(self, proba, untracked=None):
+        return decode(
+            proba,
+            self.classes_,
+            smooth_span=self.smooth_span,
+            smoothing=self.smoothing,
+            min_run=self.min_run,
+            max_gap=self.max_gap,
+            untracked=untracked,
+        )
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        tags.non_deterministic = getattr(self, "device", "cpu") != "cpu"
+        return tags
+
+    # -- incremental step (docs/design.md §4.1, "Incremental steps") -----------
+    # A tagger that reads whole sequences streams over a trailing window with
+    # a fixed look-ahead (skgesture/_taggers/_stream.py, TrailingWindowStream):
+    # probabilities of frame u once frame u + stream_future is known, then the
+    # offline decoding (the smoothing's stepper and decode on stretches that
+    # no later frame can change). Subclasses with their own step (the chunked
+    # BiLSTMTagger) override these methods.
+
+    def stream_init(self, *, max_period=1200, **options):
+        """A fresh state for one live stream (docs/design.md §4.1).
+
+        Parameters
+        ----------
+        max_period : int, default=1200
+            A stretch of frames this long that the decoding cannot cut yet
+            (one gesture, or runs of one class joined by short gaps) is
+            decided as if the stream ended there, which bounds memory;
+            offline has no such cap.
+        **options
+            Options of other stages, ignored.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+        """
+        from skgesture._taggers._stream import TrailingWindowStream
+
+        check_is_fitted(self)
+        past = getattr(self, "stream_past", DEFAULT_STREAM_PAST)
+        with torch_threads(getattr(self, "n_threads", None)):
+            scorer = self._stream_scorer(past)
+        return TrailingWindowStream(
+            scorer,
+            self.classes_,
+            past,
+            getattr(self, "stream_future", DEFAULT_STREAM_FUTURE),
+            self.smooth_span,
+            self.min_run,
+            smoothing=self.smoothing,
+            max_gap=self.max_gap,
+            max_run=max_period,
+            owner=f"{type(self).__name__}.smooth_span",
+        )
+
+    def stream_step(self, state, rows):
+        """Feature rows in; the gestures decided with them out.
+
+        The probabilities of frame ``u`` are computed when frame
+        ``u + stream_future`` arrives, from the frames up to it (a window of
+        ``stream_past`` frames before, or a recurrent network's carried
+        state), then smoothed and decoded with the offline rules
+        (:func:`skgesture._taggers._decoding.decode`); untracked (masked) rows are
+        rest.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next feature rows.
+
+        Returns
+        -------
+        out : list of StreamSegment
+            ``(label, start, end, confidence, time)`` of each gesture decided.
+        state : object
+            The updated state.
+        """
+        return state.step(rows), state
+
+    def stream_flush(self, state):
+        """End of the stream: the last frames, end-point smoothing, last run.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : list of StreamSegment
+            The remaining gestures.
+        state : object
+            The spent state.
+        """
+        return state.flush(), state
+
+    @property
+    def stream_lookahead(self):
+        """Frames between a gesture's last frame and its event, at most.
+
+        ``stream_future`` + the smoothing's look-ahead + ``max_gap`` + 1
+        (9 with the defaults).
+        """
+        from skgesture._taggers._decoding import make_smoother
+
+        future = getattr(self, "stream_future", DEFAULT_STREAM_FUTURE)
+        name = f"{type(self).__name__}.smooth_span"
+        h = make_smoother(self.smoothing, self.smooth_span, 1, owner=name).h
+        return int(future) + h + int(self.max_gap) + 1
+
+    def _stream_scorer(self, past):
+        """Probabilities of a frame in a stream: ``_raw_proba`` on a window."""
+        from skgesture._taggers._stream import WindowScorer
+
+        return WindowScorer(lambda rows: self._raw_proba([rows])[0], past)
+
+
+def _untracked(X, data):
+    """Untracked rows of every sequence: the masked rows of a masked array
+    (``data``, the validated sequences, has no mask), else the all-zero rows."""
+    return [
+        untracked_rows(x if isinstance(x, np.ma.MaskedArray) else d)
+        for x, d in zip(X, data)
+    ]
+
+
+def _rest_where(proba, rows):
+    """``proba`` with the rows ``rows`` set to certain rest (column 0)."""
+    if not rows.any():
+        return proba
+    proba = proba.copy()
+    proba[rows] = 0.0
+    proba[rows, 0] = 1.0
+    return proba

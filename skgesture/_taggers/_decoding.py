@@ -1,0 +1,350 @@
+"""Decoding of per-frame class probabilities into labels, shared by every tagger.
+
+One path for :class:`~skgesture.BiLSTMTagger` (Method C),
+:class:`~skgesture.SequenceTagger` and :class:`~skgesture.VotingTagger`:
+smooth every class track, take the arg-max per frame, merge runs of one class
+split by a short rest gap, set gesture runs shorter than ``min_run`` to rest,
+and force untracked frames to rest. Only the network depends on the training,
+so every decoding parameter can be changed after ``fit`` (and searched without
+retraining when the network is cached).
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from skgesture._stream import StreamSegment
+from skgesture.utils._buffers import RowBuffer
+from skgesture.utils._segments import labels_to_segments, remove_short_runs, runs
+from skgesture.utils._smoothing import LoessStepper, MeanStepper, loess_smooth
+
+__all__ = ["decode", "fill_short_gaps", "segments_with_confidence", "smooth_proba"]
+
+SMOOTHINGS = {"loess", "mean", "none"}
+
+
+def smooth_proba(proba, span, smoothing="loess"):
+    """Smooth every class track of ``(n_frames, n_classes)`` probabilities.
+
+    Parameters
+    ----------
+    proba : ndarray of shape (n_frames, n_classes)
+        Per-frame probabilities.
+    span : int or float
+        Window in frames (a float below 1 is a fraction of the sequence, for
+        ``"loess"``); 1 or less leaves ``proba`` unchanged.
+    smoothing : {"loess", "mean", "none"}, default="loess"
+        MATLAB-style loess (Method C), a centred moving average (edges
+        replicated), or nothing.
+
+    Returns
+    -------
+    ndarray of shape (n_frames, n_classes)
+        Smoothed probabilities.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import smooth_proba
+    >>> p = np.array([[1.0, 0], [0, 1], [1, 0]])
+    >>> smooth_proba(p, 3, "mean").round(3).tolist()
+    [[0.667, 0.333], [0.667, 0.333], [0.667, 0.333]]
+    """
+    if smoothing == "none" or len(proba) == 0:
+        return proba
+    if smoothing == "loess":
+        return np.asarray(loess_smooth(proba, span, axis=0))
+    size = int(span)
+    if size <= 1:
+        return proba
+    return uniform_filter1d(proba, size, axis=0, mode="nearest")
+
+
+def fill_short_gaps(labels, max_gap, *, rest=0):
+    """Merge two runs of one class separated by at most ``max_gap`` rest frames.
+
+    Parameters
+    ----------
+    labels : ndarray of shape (n_frames,)
+        Per-frame labels.
+    max_gap : int
+        Longest rest gap filled; 0 changes nothing.
+    rest : int, default=0
+        The rest label.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        Labels with the short gaps given the class around them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import fill_short_gaps
+    >>> fill_short_gaps(np.array([2, 2, 0, 2, 0, 0, 0, 2]), 2).tolist()
+    [2, 2, 2, 2, 0, 0, 0, 2]
+    """
+    labels = np.array(labels, copy=True)
+    if max_gap <= 0:
+        return labels
+    starts, ends, values = runs(labels)
+    for k in range(1, len(values) - 1):
+        if (
+            values[k] == rest
+            and ends[k] - starts[k] <= max_gap
+            and values[k - 1] == values[k + 1] != rest
+        ):
+            labels[starts[k] : ends[k]] = values[k - 1]
+    return labels
+
+
+def decode(
+    proba,
+    classes,
+    *,
+    smooth_span=1,
+    smoothing="loess",
+    min_run=1,
+    max_gap=0,
+    untracked=None,
+):
+    """Per-frame labels of one sequence from its class probabilities.
+
+    Parameters
+    ----------
+    proba : ndarray of shape (n_frames, n_classes)
+        Raw per-frame probabilities, columns in ``classes`` order.
+    classes : ndarray of shape (n_classes,)
+        Labels of the columns, rest (0) first.
+    smooth_span : int or float, default=1
+        Span of :func:`smooth_proba`.
+    smoothing : {"loess", "mean", "none"}, default="loess"
+        Smoothing method.
+    min_run : int, default=1
+        Shortest gesture run kept; shorter runs become rest.
+    max_gap : int, default=0
+        Rest gaps of at most this many frames between two runs of one class
+        are filled before the ``min_run`` filter.
+    untracked : ndarray of bool of shape (n_frames,) or None, default=None
+        Frames forced to rest (lost tracking is never a gesture).
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        Labels from ``classes``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import decode
+    >>> p = np.array([[0.9, 0.1]] * 3 + [[0.2, 0.8]] * 4 + [[0.9, 0.1]])
+    >>> decode(p, np.array([0, 5]), min_run=3).tolist()
+    [0, 0, 0, 5, 5, 5, 5, 0]
+    >>> decode(p, np.array([0, 5]), min_run=5).tolist()
+    [0, 0, 0, 0, 0, 0, 0, 0]
+    """
+    smoothed = smooth_proba(proba, smooth_span, smoothing)
+    labels = np.asarray(classes)[np.argmax(smoothed, axis=1)]
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    labels = fill_short_gaps(labels, max_gap)
+    labels = remove_short_runs(labels, min_run)
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    return labels
+
+
+def segments_with_confidence(labels, proba, classes):
+    """Gesture instances of decoded labels, with the mean probability of each.
+
+    Parameters
+    ----------
+    labels : ndarray of shape (n_frames,)
+        Decoded labels.
+    proba : ndarray of shape (n_frames, n_classes)
+        Raw probabilities, columns in ``classes`` order.
+    classes : ndarray of shape (n_classes,)
+        Labels of the columns.
+
+    Returns
+    -------
+    ndarray of shape (n_segments, 4)
+        Rows ``(class, start, end, confidence)``, 0-based, ``end`` exclusive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import segments_with_confidence
+    >>> p = np.array([[1.0, 0.0], [0.2, 0.8], [0.4, 0.6]])
+    >>> segments_with_confidence(np.array([0, 3, 3]), p, np.array([0, 3])).tolist()
+    [[3.0, 1.0, 3.0, 0.7]]
+    """
+    rows = [
+        (c, s, e, float(proba[s:e, np.searchsorted(classes, c)].mean()))
+        for c, s, e in labels_to_segments(labels)
+    ]
+    return np.array(rows, dtype=float).reshape(-1, 4)
+
+
+def make_smoother(smoothing, span, n_tracks, owner="smooth_span"):
+    """The stepper of ``smooth_proba(proba, span, smoothing)`` for a stream.
+
+    Parameters
+    ----------
+    smoothing : {"loess", "mean", "none"}
+        As :func:`skgesture._taggers._decoding.smooth_proba`.
+    span : int or float
+        Its span (a loess fraction of the sequence is refused: a stream has no
+        length).
+    n_tracks : int
+        Class tracks.
+    owner : str, default="smooth_span"
+        Parameter name for error messages.
+
+    Returns
+    -------
+    LoessStepper or MeanStepper
+        With ``step(values, times)``, ``flush(now)``, ``held()`` and ``h``,
+        the rows of look-ahead.
+    """
+    if smoothing == "none":
+        return LoessStepper(1, n_tracks, owner=owner)  # span 1: rows pass through
+    if smoothing == "mean":
+        return MeanStepper(span, n_tracks)
+    return LoessStepper(span, n_tracks, owner=owner)
+
+
+class LabelRuns:
+    """The decoding of a tagger's smoothed scores, one stretch at a time.
+
+    The offline rules of :func:`skgesture._taggers._decoding.decode` (arg-max, rest on
+    masked rows, rest gaps of at most ``max_gap`` frames between two runs of
+    one class filled, gesture runs shorter than ``min_run`` set to rest) and
+    the segments and confidences of
+    :func:`skgesture._taggers._decoding.segments_with_confidence`, applied by calling
+    those functions on stretches of rows that no later row can change: the
+    stream is cut where the labels before and after cannot interact, i.e.
+    between two different gesture labels, before a gesture whose preceding
+    rest gap cannot be filled, and inside a rest run longer than ``max_gap``.
+    A run of one gesture is therefore emitted once ``max_gap + 1`` rest rows
+    follow it (its first rest row for ``max_gap=0``) or another gesture
+    starts; the segments equal the offline ones on the whole stream.
+
+    Parameters
+    ----------
+    classes : ndarray
+        Class of every score column, rest (0) first.
+    min_run : int
+        Shortest run kept.
+    max_gap : int, default=0
+        Longest rest gap filled between two runs of one class.
+    max_run : int or None, default=None
+        A stretch this long without a cut is decided as if the stream ended
+        there (bounds memory on a stream that never rests; offline has no
+        such cap). None: no cap.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import decode
+    >>> from skgesture._taggers._decoding import LabelRuns
+    >>> lab = np.array([0, 0, 1, 1, 0, 1, 1, 0, 0, 0, 2, 2, 2, 0])
+    >>> p = np.eye(3)[lab]
+    >>> runs = LabelRuns(np.arange(3), min_run=3, max_gap=1)
+    >>> segs = []
+    >>> for t in range(len(p)):
+    ...     segs += runs.feed(t, p[t : t + 1], p[t : t + 1], [False], [t])
+    >>> segs += runs.end(len(p), len(p) - 1)
+    >>> [(s.label, s.start, s.end, s.time) for s in segs]
+    [(1, 2, 7, 8), (2, 10, 13, 13)]
+    >>> decode(p, np.arange(3), min_run=3, max_gap=1, smoothing="none").tolist()
+    [0, 0, 1, 1, 1, 1, 1, 0, 0, 0, 2, 2, 2, 0]
+    """
+
+    def __init__(self, classes, min_run, max_gap=0, max_run=None):
+        self.classes = np.asarray(classes)
+        self.min_run = int(min_run)
+        self.max_gap = int(max_gap)
+        self.max_run = None if max_run is None else max(int(max_run), 1)
+        n = len(self.classes)
+        self.smoothed = RowBuffer((n,), capacity=64)
+        self.raw = RowBuffer((n,), capacity=64)
+        self.rest = RowBuffer((), dtype=bool, capacity=64)
+        self.cs = 0  # first row of the stretch not yet decided
+        self.n = 0  # rows fed
+        self.gestures = 0  # gesture labels in the stretch
+        self.label = 0  # label of the current run
+        self.start = 0  # its first row
+        self.before = 0  # label of the run before it
+
+    def feed(self, lo, smoothed, raw, rest, times):
+        """Rows ``lo ..`` in (smoothed and raw scores, rest flags, times); the
+        segments of the stretches they close out."""
+        smoothed = np.asarray(smoothed)
+        rest = np.asarray(rest, dtype=bool)
+        if lo != self.n:
+            raise IndexError(f"rows fed out of order: {lo}, expected {self.n}")
+        labels = self.classes[np.argmax(smoothed, axis=1)]
+        labels[rest] = 0
+        self.smoothed.append(smoothed)
+        self.raw.append(raw, rest)
+        self.rest.append(rest)
+        out = []
+        gap = self.max_gap
+        for i, lab in enumerate(labels.tolist()):
+            j = lo + i
+            self.n = j + 1
+            if lab != self.label:
+                if lab != 0 and (
+                    self.label != 0  # between two different gestures
+                    or self.start <= self.cs  # after a rest run already cut
+                    or j - self.start > gap  # after a long rest gap
+                    or self.before != lab  # between two different classes
+                ):
+                    self._cut(j, int(times[i]), out)
+                self.before, self.label, self.start = self.label, lab, j
+            if lab != 0:
+                self.gestures += 1
+            elif j + 1 - self.start > gap:
+                self._cut(j + 1, int(times[i]), out)  # inside a long rest run
+            if self.max_run is not None and j + 1 - self.cs >= self.max_run:
+                self._cut(j + 1, int(times[i]), out)
+        return out
+
+    def end(self, stop, now):
+        """The stream ends at row ``stop``: the segments of the last stretch."""
+        out = []
+        self._cut(stop, int(now), out)
+        self.label, self.start, self.before = 0, stop, 0
+        return out
+
+    def _cut(self, b, now, out):
+        """Decide rows ``cs .. b - 1`` with the offline functions."""
+        from skgesture._taggers._decoding import decode, segments_with_confidence
+
+        cs = self.cs
+        if b <= cs:
+            return
+        if self.gestures:
+            rest = self.rest.data(cs, b)
+            labels = decode(
+                self.smoothed.data(cs, b),
+                self.classes,
+                smoothing="none",  # the rows are already smoothed
+                min_run=self.min_run,
+                max_gap=self.max_gap,
+                untracked=rest,
+            )
+            for cls, s, e, conf in segments_with_confidence(
+                labels, self.raw.data(cs, b), self.classes
+            ).tolist():
+                out.append(StreamSegment(int(cls), cs + int(s), cs + int(e), conf, now))
+        self.cs = b
+        self.gestures = 0
+        for buf in (self.smoothed, self.raw, self.rest):
+            buf.drop(b)
+
+    def held(self):
+        """Rows of the stretch not yet decided."""
+        return self.n - self.cs

@@ -1,0 +1,377 @@
+"""SequenceTagger: GRU, LSTM or MS-TCN tagger of whole sequences.
+
+The tagger of the recommended model (:func:`~skgesture.make_recommended`).
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import _fit_context, clone
+from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
+
+from skgesture._augment import SkeletonAugmenter
+from skgesture._nn._modules import (
+    RecurrentTaggerModule,
+    TemporalConvModule,
+)
+from skgesture._nn._sequence_net import _CropNet, predict_whole
+from skgesture._nn._training import seed_from
+from skgesture._taggers._base import (
+    _DECODING_CONSTRAINTS,
+    _STREAM_CONSTRAINTS,
+    _BaseTagger,
+)
+
+__all__ = ["SequenceTagger"]
+
+
+class SequenceTagger(_BaseTagger):
+    """Network labelling every frame of whole sequences (the recommended tagger).
+
+    A bidirectional GRU (or LSTM, or an MS-TCN temporal convolutional network)
+    reads each whole sequence and gives every frame one of K + 1 classes (rest
+    included). Unlike Method C, which reads 10-frame chunks with a fresh state,
+    it sees the whole context of every frame.
+
+    Training draws random ``crop_length``-frame crops of the training
+    sequences, perturbs them with ``augment`` (rotation about the vertical
+    axis, scaling, time warping, noise), standardises the features with the
+    training statistics, and minimises the framewise cross-entropy (plus the
+    MS-TCN smoothing loss if ``smoothing_weight > 0``) with AdamW, a
+    one-cycle learning-rate schedule and gradient-norm clipping, for
+    ``max_epochs`` epochs of ``steps_per_epoch`` batches; with
+    ``early_stopping`` whole sequences are held out and the best epoch kept.
+
+    Prediction runs the network over each whole sequence, then decodes the
+    probabilities: smoothing of every class track, arg-max, rest gaps of at
+    most ``max_gap`` frames between runs of one class filled, gesture runs
+    shorter than ``min_run`` set to rest. Decoding never retrains: with
+    ``memory`` a search over it trains once per fold.
+
+    Parameters
+    ----------
+    architecture : {"gru", "lstm", "tcn"}, default="gru"
+        Bidirectional GRU, bidirectional LSTM, or MS-TCN.
+    hidden_sizes : tuple of int, default=(64, 64)
+        Units per direction of each recurrent layer; for ``"tcn"`` the first
+        entry is the channel count of every layer.
+    dropout : float, default=0.0
+        Drop probability between recurrent layers / inside the TCN layers.
+    tcn_layers : int, default=8
+        Dilated residual layers per MS-TCN stage (dilations 1, 2, 4, ...; a
+        stage sees ``2 ** (tcn_layers + 1) - 1`` frames).
+    tcn_stages : int, default=2
+        Stages of the MS-TCN (ignored by the recurrent architectures).
+    smoothing_weight : float, default=0.0
+        Weight of the MS-TCN smoothing loss (0.15 in Farha & Gall 2019).
+    crop_length : int, default=128
+        Frames per training crop.
+    batch_size : int, default=32
+        Crops per batch.
+    steps_per_epoch : int, default=20
+        Batches per epoch.
+    max_epochs : int, default=15
+        Epochs; the one-cycle schedule spans ``max_epochs * steps_per_epoch``
+        steps.
+    learning_rate : float, default=3e-3
+        Peak learning rate of the one-cycle schedule.
+    weight_decay : float, default=1e-4
+        AdamW weight decay.
+    clip_norm : float or None, default=1.0
+        Largest gradient norm; None disables clipping.
+    class_weight : None, "balanced" or float, default=None
+        Cross-entropy weight per class: none, inverse class frequency
+        (``"balanced"``), or inverse frequency raised to this power (0.5 is a
+        milder balance).
+    augment : SkeletonAugmenter or None, default=None
+        Augmentation of the training crops (needs xyz-triple features such as
+        :class:`JointFeatures`'s when it rotates or scales).
+    standardize : bool, default=True
+        Z-score every feature with the training mean and standard deviation.
+    early_stopping : bool, default=False
+        Hold out ``validation_fraction`` of the training sequences, stop after
+        ``n_iter_no_change`` epochs without a lower validation loss, and keep
+        the best epoch's weights.
+    validation_fraction : float, default=0.15
+        Share of the sequences held out with ``early_stopping``.
+    n_iter_no_change : int, default=5
+        Patience of the early stopping, in epochs.
+    smooth_span : int or float, default=1
+        Window of the probability smoothing, in frames (1: none).
+    smoothing : {"loess", "mean", "none"}, default="mean"
+        Smoothing method.
+    min_run : int, default=1
+        Shortest gesture run kept, in frames.
+    max_gap : int, default=0
+        Longest rest gap filled between two runs of one class.
+    stream_past : int, default=32
+        Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
+        frames before a frame that a network reading a window (the TCN, or
+        any other) sees; a recurrent network carries its forward state from
+        the start of the stream instead (docs/streaming.md, "The recommended
+        model").
+    stream_future : int, default=8
+        Streaming only: frames after a frame that the network sees before
+        its probabilities are computed; the stage's delay is ``stream_future``
+        plus the smoothing's half span plus ``max_gap`` plus 1.
+    memory : None, str or joblib.Memory, default=None
+        Caches the trained network keyed on the training data and the network
+        and training parameters only.
+    device : str, default="cpu"
+        Torch device of the training; a fitted tagger predicts on the CPU of a
+        machine without CUDA.
+    n_threads : int or None, default=1
+        Torch intra-op threads while fitting and predicting (restored
+        afterwards); None keeps torch's setting.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the initialisation, the crops, the augmentation, the dropout and
+        the validation split; an int gives identical results on the CPU.
+    verbose : int, default=0
+        0 silent, 1 a progress bar over epochs, 2 one line per epoch.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        Labels seen in ``fit``, rest (0) first.
+    net_ : skorch.NeuralNet
+        The trained network (``net_.history`` holds the losses).
+    mean_ : ndarray of shape (n_features,)
+        Training mean of every feature.
+    scale_ : ndarray of shape (n_features,)
+        Training standard deviation of every feature.
+    n_features_in_ : int
+        Number of features per frame.
+    frame_shape_in_ : tuple of int
+        Shape of one input frame, ``(n_features_in_,)``.
+
+    See Also
+    --------
+    make_recommended : The pipeline built around this tagger.
+    BiLSTMTagger : Method C, the paper's chunked BiLSTM.
+    VotingTagger : Soft voting over several taggers.
+
+    Notes
+    -----
+    Frames of an input ``numpy.ma.MaskedArray`` that are masked (untracked
+    skeletons) are left out of the loss in ``fit`` and are rest at
+    prediction. A sequence of any length >= 1 can be predicted.
+
+    References
+    ----------
+    .. [1] Farha & Gall, "MS-TCN: Multi-Stage Temporal Convolutional Network
+       for Action Segmentation", CVPR 2019.
+
+    Examples
+    --------
+    >>> from skgesture import JointFeatures, SequenceTagger
+    >>> from skgesture.utils._testing import make_skeleton_stream
+    >>> X, y = make_skeleton_stream(random_state=0)
+    >>> F = JointFeatures().fit_transform([X])
+    >>> tagger = SequenceTagger(hidden_sizes=(16,), max_epochs=2, random_state=0)
+    >>> tagger = tagger.fit(F, [y])
+    >>> tagger.classes_.tolist()
+    [0, 1, 2, 3]
+    >>> tagger.predict(F)[0].shape == y.shape
+    True
+    """
+
+    _parameter_constraints: dict = {
+        "architecture": [StrOptions({"gru", "lstm", "tcn"})],
+        "hidden_sizes": [tuple, list],
+        "dropout": [Interval(Real, 0, 1, closed="left")],
+        "tcn_layers": [Interval(Integral, 1, None, closed="left")],
+        "tcn_stages": [Interval(Integral, 1, None, closed="left")],
+        "smoothing_weight": [Interval(Real, 0, None, closed="left")],
+        "crop_length": [Interval(Integral, 2, None, closed="left")],
+        "batch_size": [Interval(Integral, 1, None, closed="left")],
+        "steps_per_epoch": [Interval(Integral, 1, None, closed="left")],
+        "max_epochs": [Interval(Integral, 1, None, closed="left")],
+        "learning_rate": [Interval(Real, 0, None, closed="neither")],
+        "weight_decay": [Interval(Real, 0, None, closed="left")],
+        "clip_norm": [Interval(Real, 0, None, closed="neither"), None],
+        "class_weight": [
+            StrOptions({"balanced"}),
+            Interval(Real, 0, None, closed="left"),
+            None,
+        ],
+        "augment": [SkeletonAugmenter, None],
+        "standardize": ["boolean"],
+        "early_stopping": ["boolean"],
+        "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
+        "n_iter_no_change": [Interval(Integral, 1, None, closed="left")],
+        **_DECODING_CONSTRAINTS,
+        **_STREAM_CONSTRAINTS,
+        "memory": [None, str, HasMethods(["cache"])],
+        "device": [str],
+        "n_threads": [Interval(Integral, 1, None, closed="left"), None],
+        "random_state": ["random_state"],
+        "verbose": ["verbose"],
+    }
+
+    def __init__(
+        self,
+        *,
+        architecture="gru",
+        hidden_sizes=(64, 64),
+        dropout=0.0,
+        tcn_layers=8,
+        tcn_stages=2,
+        smoothing_weight=0.0,
+        crop_length=128,
+        batch_size=32,
+        steps_per_epoch=20,
+        max_epochs=15,
+        learning_rate=3e-3,
+        weight_decay=1e-4,
+        clip_norm=1.0,
+        class_weight=None,
+        augment=None,
+        standardize=True,
+        early_stopping=False,
+        validation_fraction=0.15,
+        n_iter_no_change=5,
+        smooth_span=1,
+        smoothing="mean",
+        min_run=1,
+        max_gap=0,
+        stream_past=32,
+        stream_future=8,
+        memory=None,
+        device="cpu",
+        n_threads=1,
+        random_state=None,
+        verbose=0,
+    ):
+        self.architecture = architecture
+        self.hidden_sizes = hidden_sizes
+        self.dropout = dropout
+        self.tcn_layers = tcn_layers
+        self.tcn_stages = tcn_stages
+        self.smoothing_weight = smoothing_weight
+        self.crop_length = crop_length
+        self.batch_size = batch_size
+        self.steps_per_epoch = steps_per_epoch
+        self.max_epochs = max_epochs
+        self.learning_rate = learning_rate
+        self.weight_decay = weight_decay
+        self.clip_norm = clip_norm
+        self.class_weight = class_weight
+        self.augment = augment
+        self.standardize = standardize
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.smooth_span = smooth_span
+        self.smoothing = smoothing
+        self.min_run = min_run
+        self.max_gap = max_gap
+        self.stream_past = stream_past
+        self.stream_future = stream_future
+        self.memory = memory
+        self.device = device
+        self.n_threads = n_threads
+        self.random_state = random_state
+        self.verbose = verbose
+
+    @_fit_context(prefer_skip_nested_validation=False)
+    def fit(self, X, y):
+        """Train the network on random crops of the sequences.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_features)
+            Per-frame features (e.g. from :class:`JointFeatures`).
+        y : list of ndarray of shape (n_frames_i,)
+            Per-frame labels, 0 = rest, 1..K gesture classes; both rest and
+            gesture frames must occur.
+
+        Returns
+        -------
+        self : SequenceTagger
+            The fitted tagger.
+        """
+        hidden = self.hidden_sizes
+        if len(hidden) == 0 or not all(
+            isinstance(h, Integral) and not isinstance(h, bool) and h >= 1
+            for h in hidden
+        ):
+            raise ValueError(
+                "hidden_sizes must be a non-empty tuple of positive ints, got "
+                f"{hidden!r}"
+            )
+        X, y_idx, classes = self._validate_fit(X, y)
+        self._class_weight = _class_weights(self.class_weight, y_idx, len(classes))
+        return self._fit_network([x.astype(np.float32) for x in X], y_idx, classes)
+
+    def _network(self, n_classes):
+        return _CropNet(
+            n_classes=n_classes,
+            architecture=self.architecture,
+            hidden_sizes=tuple(int(h) for h in self.hidden_sizes),
+            dropout=float(self.dropout),
+            tcn_layers=self.tcn_layers,
+            tcn_stages=self.tcn_stages,
+            smoothing_weight=self.smoothing_weight,
+            crop_length=self.crop_length,
+            batch_size=self.batch_size,
+            steps_per_epoch=self.steps_per_epoch,
+            max_epochs=self.max_epochs,
+            learning_rate=self.learning_rate,
+            weight_decay=self.weight_decay,
+            clip_norm=self.clip_norm,
+            class_weight=self._class_weight,
+            augmenter=None if self.augment is None else clone(self.augment),
+            standardize=self.standardize,
+            early_stopping=self.early_stopping,
+            validation_fraction=self.validation_fraction,
+            n_iter_no_change=self.n_iter_no_change,
+            device=self.device,
+            random_state=(
+                None if self.random_state is None else seed_from(self.random_state)
+            ),
+            verbose=self.verbose,
+        )
+
+    def _adopt(self, fitted):
+        self.net_ = fitted.net_
+        self.mean_ = fitted.mean_
+        self.scale_ = fitted.scale_
+
+    def _raw_proba(self, X):
+        return predict_whole(
+            self.net_.module_, X, self.mean_, self.scale_, len(self.classes_)
+        )
+
+    def _stream_scorer(self, past):
+        """The recurrent network with its forward states carried along the
+        stream, else the network on a window of ``past`` frames (the MS-TCN
+        in numpy: :class:`~skgesture._nn._fast.TemporalConvProba`)."""
+        from skgesture._nn._fast import RecurrentScorer, TemporalConvProba
+        from skgesture._taggers._stream import WindowScorer
+
+        module = self.net_.module_
+        on_cpu = next(module.parameters()).device.type == "cpu"
+        if type(module) is RecurrentTaggerModule and on_cpu:
+            return RecurrentScorer(module, self.mean_, self.scale_)
+        if type(module) is TemporalConvModule and on_cpu:
+            proba = TemporalConvProba(module, self.mean_, self.scale_)
+            return WindowScorer(proba, past)
+        n_classes = len(self.classes_)
+
+        def proba(rows):
+            return predict_whole(module, [rows], self.mean_, self.scale_, n_classes)[0]
+
+        return WindowScorer(proba, past)
+
+
+def _class_weights(class_weight, y_idx, n_classes):
+    """Per-class cross-entropy weights (a list, for a stable cache key)."""
+    if class_weight is None:
+        return None
+    labels = np.concatenate(y_idx)
+    counts = np.bincount(labels[labels >= 0], minlength=n_classes).astype(float)
+    balanced = counts.sum() / (n_classes * np.maximum(counts, 1.0))
+    power = 1.0 if class_weight == "balanced" else float(class_weight)
+    return [float(w) for w in balanced**power]
