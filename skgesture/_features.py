@@ -17,11 +17,17 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
 from skgesture._descriptor._compute import _fill_missing
-from skgesture._stream import DEFAULT_MAX_BACKFILL, Rows
+from skgesture._stream import DEFAULT_MAX_BACKFILL, Rows, StreamableMixin
 from skgesture.layouts import KINECT_V1, N_COORDS, get_descriptor_joints
-from skgesture.utils._buffers import RowBuffer, RunningMedian, _concat_rows
+from skgesture.utils._buffers import (
+    HeldFrames,
+    RowBuffer,
+    RunningMedian,
+    _concat_rows,
+)
 from skgesture.utils._validation import (
     check_skeletons,
+    check_stream_frames,
     missing_frames,
     refuse_set_output,
 )
@@ -163,7 +169,7 @@ def _with_derivatives(flat, velocities, accelerations):
     return np.hstack(parts).astype(np.float32)
 
 
-class JointFeatures(TransformerMixin, BaseEstimator):
+class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
     """Body-normalised joint positions and velocities of every frame.
 
     Per sequence: untracked frames are filled (as :class:`PoseDescriptor`
@@ -377,11 +383,24 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         return tags
 
     # -- incremental step (docs/design.md §4.1, "Incremental steps") -----------
-    # The state and the per-row arithmetic are JointFeatureStream, below
-    # (JointFeatureStream), built on the steps of joint_features above.
+    # StreamableMixin writes stream_init/step/flush; the state and the per-row
+    # arithmetic are JointFeatureStream, below, built on the steps of
+    # joint_features above.
 
-    def stream_init(self, *, max_backfill=64, **options):
+    _stream_options = ("max_backfill",)
+
+    def _stream_state(self, *, max_backfill=DEFAULT_MAX_BACKFILL):
         """A fresh state for one live stream (docs/design.md §4.1).
+
+        Raw frames in, the feature rows that became final out. Every frame is
+        checked as :meth:`transform` checks it (a bad one raises a
+        ``ValueError`` naming its stream index, the state unchanged). Row
+        ``t`` comes with frame ``t + 1`` (``t + 2`` with accelerations; the
+        central differences of ``numpy.gradient``), the first rows not before
+        frame ``stream_warmup - 1``, normalised with the statistics of the
+        last ``stream_stats_window`` tracked frames received by then.
+        Untracked frames hold the last tracked frame (the future is unknown;
+        offline ``fill="hold"``) and come out masked.
 
         Parameters
         ----------
@@ -389,12 +408,10 @@ class JointFeatures(TransformerMixin, BaseEstimator):
             Untracked frames at the start of a stream that wait for the first
             tracked frame and become copies of it, as offline filling does;
             earlier ones are handed on at once as rest (masked zero rows).
-        **options
-            Options of other stages, ignored.
 
         Returns
         -------
-        object
+        JointFeatureStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
 
         Examples
@@ -412,67 +429,14 @@ class JointFeatures(TransformerMixin, BaseEstimator):
         >>> len(last), rows.data.shape[1] == feats.n_features_out_
         (1, True)
         """
-        from skgesture._features import JointFeatureStream
-
         check_is_fitted(self)
-        names, _ = _joint_names(self.joints)
+        names, index = _joint_names(self.joints)
         if names != self.joint_names_:
             raise ValueError(
                 f"joints was changed after fit ({list(self.joint_names_)} -> "
                 f"{list(names)}); refit the features and every stage after them"
             )
-        return JointFeatureStream(self, max_backfill=max_backfill)
-
-    def stream_step(self, state, rows):
-        """Raw frames in; the feature rows that became final out.
-
-        Every frame is checked as :meth:`transform` checks it, and a bad one
-        raises a ``ValueError`` naming its index in the stream (the state is
-        then unchanged). Row ``t`` comes with frame ``t + 1`` (``t + 2`` with
-        accelerations; the central differences of ``numpy.gradient``), the
-        first rows not before frame ``stream_warmup - 1``, normalised with the
-        statistics of the last ``stream_stats_window`` tracked frames received
-        by then. Untracked frames hold the last tracked frame (the future is
-        unknown; offline ``fill="hold"``) and come out masked.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next raw frames ``(n, 20, 3)``, with their stream indices as
-            ``time``.
-
-        Returns
-        -------
-        out : Rows
-            Feature rows ``(m, n_features_out_)``, float32, masked where
-            untracked.
-        state : object
-            The updated state.
-        """
-        from skgesture._stream import Rows
-        from skgesture.utils._validation import check_stream_frames
-
-        frames = check_stream_frames(self, rows.data, int(rows.time[0]))
-        return state.step(Rows(frames, rows.mask, rows.time)), state
-
-    def stream_flush(self, state):
-        """End of the stream: the last rows, with one-sided end differences.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : Rows
-            The remaining rows.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
+        return JointFeatureStream(self, index, max_backfill=max_backfill)
 
     @property
     def stream_lookahead(self):
@@ -504,19 +468,13 @@ class JointFeatureStream:
     as masked zero rows.
     """
 
-    def __init__(self, feats, max_backfill=DEFAULT_MAX_BACKFILL):
-        from skgesture._features import (
-            _frame_quantities,
-            _normalised,
-            _statistics,
-            _with_derivatives,
-        )
-
+    def __init__(self, feats, index, max_backfill=DEFAULT_MAX_BACKFILL):
+        self.estimator = feats
         self.quantities = _frame_quantities
         self.statistics = _statistics
         self.normalised = _normalised
         self.derivatives = _with_derivatives
-        self.index = feats._joint_index
+        self.index = index
         self.velocities = bool(feats.velocities)
         self.accelerations = bool(feats.accelerations)
         self.align = bool(feats.align)
@@ -526,7 +484,8 @@ class JointFeatureStream:
         self.ready = int(getattr(feats, "stream_warmup", 0)) - 1  # ends the warm-up
         self.width = int(feats.n_features_out_)
         self.max_backfill = int(max_backfill)
-        self.R = RowBuffer((20, 3), capacity=32)  # filled raw frames, from p0
+        self.held_frames = HeldFrames(max_backfill)
+        self.R = self.held_frames.frames  # filled raw frames, from p0
         self.untracked = RowBuffer((), dtype=bool, capacity=32)
         self.times = RowBuffer((), dtype=np.int64, capacity=32)
         self.Q = RowBuffer((7,), capacity=64)  # quantities of the tracked frames
@@ -535,15 +494,14 @@ class JointFeatureStream:
         self.n_out = 0
         self.p0 = None  # first frame with a filled raw frame
         self.f = None  # first tracked frame
-        self.last = None  # the last tracked frame
         self.medians = RunningMedian(7 if self.align else 4, self.window)
         self.cached = (None, None)  # (tracked frames used, statistics)
 
     def step(self, rows):
-        """Validated raw frames in; the feature rows that became final out."""
-        from skgesture.utils._validation import missing_frames
-
-        frames, times = rows.data, rows.time
+        """Raw frames in (checked as offline); the feature rows that became
+        final out."""
+        frames = check_stream_frames(rows.data, int(rows.time[0]), self.estimator)
+        times = rows.time
         first = self.n_in
         self.n_in += len(frames)
         untracked = missing_frames(frames)
@@ -553,28 +511,10 @@ class JointFeatureStream:
         if tracked.any():
             self.Q.append(self.quantities(frames[tracked]))
             self.Q_frame.append(first + np.flatnonzero(tracked))
-        out = []
-        if self.p0 is None:
-            if untracked.all():
-                out.append(self._zeros(self.n_in - self.max_backfill))
-                return _concat_rows(out, (self.width,), np.float32)
-            k = int(np.argmax(tracked))
-            out.append(self._zeros(first + k - self.max_backfill))
-            self.p0, self.f = self.n_out, first + k
-            self.R.restart(self.p0)
-            # The leading frames kept back become copies of the first tracked one.
-            self.R.append(np.repeat(frames[k : k + 1], self.f - self.p0, axis=0))
-            self.last = frames[k]
-            frames, untracked = frames[k:], untracked[k:]
-        if untracked.any():  # hold: an untracked frame repeats the last tracked one
-            frames = frames.copy()
-            src = np.maximum.accumulate(
-                np.where(~untracked, np.arange(len(frames)), -1)
-            )
-            frames[src < 0] = self.last
-            frames[src >= 0] = frames[src[src >= 0]]
-        self.last = frames[-1]
-        self.R.append(frames)
+        out = self.held_frames.push(frames, untracked, first, self.n_out, self._zeros)
+        if self.held_frames.p0 is None:
+            return _concat_rows(out, (self.width,), np.float32)
+        self.p0, self.f = self.held_frames.p0, self.held_frames.first_tracked
         out.append(self._advance())
         return _concat_rows(out, (self.width,), np.float32)
 

@@ -13,7 +13,7 @@ from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 from skgesture._nn._fast import fast_proba
 from skgesture._nn._mlp import TorchMLPClassifier
 from skgesture._nn._training import fit_inner_estimator
-from skgesture._stream import Rows
+from skgesture._stream import Rows, StreamableMixin
 from skgesture.utils._buffers import RowBuffer, _concat_rows
 from skgesture.utils._segments import remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, loess_smooth
@@ -80,7 +80,11 @@ def context_mask(y, n_context):
 
 
 class ActivitySegmenter(
-    ClassifierMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+    StreamableMixin,
+    ClassifierMixin,
+    TransformerMixin,
+    BaseEstimator,
+    auto_wrap_output_keys=None,
 ):
     """Framewise gesture-vs-rest detector giving the periods of activity.
 
@@ -397,65 +401,25 @@ class ActivitySegmenter(
     # The state (skgesture/_segmenter.py, SegmenterStream) uses the same
     # network, loess and rules as predict; tests/test_streaming.py checks it.
 
-    def stream_init(self, **options):
+    _stream_options = ()
+
+    def _stream_state(self):
         """A fresh state for one live stream (docs/design.md, "Incremental steps").
 
-        Parameters
-        ----------
-        **options
-            Options of other stages, ignored.
+        Descriptor rows in, the rows whose activity became final out. A row is
+        scored by the network, its smoothed score is known ``h = (smooth_span -
+        1) / 2`` rows later (:attr:`stream_lookahead`), and an active row is
+        handed on once its run of active rows reaches ``min_length``. The
+        output is the rows of :meth:`transform`: the descriptors, masked where
+        at rest (untracked rows included); at the end, loess end-point fits.
 
         Returns
         -------
-        object
+        SegmenterStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._segmenter import SegmenterStream
-
         check_is_fitted(self)
         return SegmenterStream(self)
-
-    def stream_step(self, state, rows):
-        """Descriptor rows in; the rows whose activity became final out.
-
-        A row is scored by the network, its smoothed score is known ``h =
-        (smooth_span - 1) / 2`` rows later (:attr:`stream_lookahead`), and an
-        active row is handed on once its run of active rows reaches
-        ``min_length``. The output is the rows of :meth:`transform`: the
-        descriptors, masked where at rest (untracked rows included).
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next descriptor rows.
-
-        Returns
-        -------
-        out : Rows
-            Rows handed on, masked at rest.
-        state : object
-            The updated state.
-        """
-        return state.step(rows), state
-
-    def stream_flush(self, state):
-        """End of the stream: the last rows, with loess end-point fits.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : Rows
-            The remaining rows.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
 
     @property
     def stream_lookahead(self):

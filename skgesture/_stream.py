@@ -1,11 +1,14 @@
-"""Incremental steps: how every stage of a pipeline runs on a live stream.
+"""The streaming protocol: how every stage of a pipeline runs on a live stream.
 
-The protocol (docs/design.md, "Incremental steps"). A fitted stage that can
-stream has three methods and one property:
+This module is the base of every stage's live step; it imports numpy and
+nothing of skgesture (tests/test_structure.py holds it so). The protocol
+(docs/design.md, "Incremental steps"): a fitted stage that can stream has
+three methods and one property, written once by :class:`StreamableMixin`:
 
 ``stage.stream_init(**options) -> state``
-    A fresh state for one stream. Options a stage does not know are ignored
-    (the recogniser passes the same options to every stage).
+    A fresh state for one stream. A stage takes the options it declares
+    (``_stream_options``) and refuses any other; the recogniser routes each
+    option to the stages that declare it.
 ``stage.stream_step(state, rows) -> (out, state)``
     ``rows`` are the next frames of the stream (a :class:`Rows` block, one row
     per frame, in order, never empty); ``out`` holds everything that became
@@ -27,13 +30,11 @@ a stage hands on exactly one row per input frame, in order (contract 1 of the
 data), possibly later. Masked rows are rest (untracked frames, or frames the
 segmenter finds at rest), as in the offline masked arrays (contract 2).
 
-The building blocks here (:class:`RowBuffer`, :class:`LoessStepper`,
-:class:`LabelRuns`, :func:`fast_proba`) are shared by the stages' steps; the
-stages' own steps (``DescriptorStream`` ... ``TaggerStream``) reuse the
-offline decision rules (``decide_period``, ``period_windows``,
-``dynamic_poses``, ``loess_smooth``), so that a stream gives the rows and the
-segments of offline ``transform`` and ``predict_segments`` on the whole
-recording.
+A stage's state lives beside the stage (``_descriptor/_stream.py``,
+``_segmenter.py``, ``_windows.py``, ``_multiscale/_stream.py``,
+``_features.py``, ``_taggers/_stream.py``); the building blocks they share are
+in :mod:`skgesture.utils` (``RowBuffer``, ``LoessStepper``) and
+:mod:`skgesture._taggers._decoding` (``LabelRuns``).
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -43,6 +44,7 @@ from typing import NamedTuple
 import numpy as np
 
 __all__ = [
+    "StreamableMixin",
     "DEFAULT_MAX_BACKFILL",
     "DEFAULT_MAX_PERIOD",
     "Rows",
@@ -143,3 +145,92 @@ def stream_frames(frames, first):
 
 
 # -- JointFeatures, one frame at a time --------------------------------------------
+
+
+class StreamableMixin:
+    """Mixin of a stage that runs on a live stream, one block of rows at a time.
+
+    Writes the protocol of the module docstring once, as imbalanced-learn's
+    ``SamplerMixin`` writes ``fit_resample``. A stage provides:
+
+    * ``_stream_options``: the names of the options its ``stream_init``
+      takes (a tuple; empty by default);
+    * ``_stream_state(**options)``: a fresh state for one stream, an object
+      with ``step(rows)`` (the outputs that became final with ``rows``),
+      ``flush()`` (the remaining outputs) and ``held()`` (rows held, by
+      buffer); the stage checks that it is fitted there;
+    * ``stream_lookahead``: an int property (see the module docstring).
+
+    Offline ``transform``/``predict_segments`` and the live step share their
+    rules; tests/test_streaming.py checks that a stream gives the offline
+    output of the whole recording.
+    """
+
+    _stream_options = ()
+
+    def stream_init(self, **options):
+        """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Parameters
+        ----------
+        **options
+            The options this stage declares (``_stream_options``), e.g.
+            ``max_backfill`` for the first stage or ``max_period`` for the
+            last; see the stage's ``_stream_state``.
+
+        Returns
+        -------
+        object
+            The state, for :meth:`stream_step` and :meth:`stream_flush`.
+
+        Raises
+        ------
+        TypeError
+            On an option the stage does not declare.
+        """
+        unknown = sorted(set(options) - set(self._stream_options))
+        if unknown:
+            takes = ", ".join(self._stream_options) or "no option"
+            raise TypeError(
+                f"{type(self).__name__}.stream_init got the unknown option(s) "
+                f"{', '.join(unknown)}; it takes {takes}"
+            )
+        return self._stream_state(**options)
+
+    def stream_step(self, state, rows):
+        """The next rows of the stream in; what became final with them out.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+        rows : Rows
+            The next rows (raw frames for the first stage), never empty, with
+            their stream indices or completion times as ``time``.
+
+        Returns
+        -------
+        out : Rows or list of StreamSegment
+            The output rows that became final (a transformer), or the gestures
+            decided (the last stage).
+        state : object
+            The updated state.
+        """
+        return state.step(rows), state
+
+    def stream_flush(self, state):
+        """End of the stream: the remaining outputs, with the offline end rules.
+
+        Parameters
+        ----------
+        state : object
+            From :meth:`stream_init`.
+
+        Returns
+        -------
+        out : Rows, list of StreamSegment or None
+            The remaining outputs (``None`` when nothing was held back).
+        state : object
+            The spent state.
+        """
+        return state.flush(), state

@@ -9,6 +9,7 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
+from skgesture._stream import Rows, StreamableMixin
 from skgesture.utils._validation import (
     SequenceOf,
     check_sequences,
@@ -310,7 +311,9 @@ def check_lazy_windows(X, steps, n_poses, estimator, reset):
     return True
 
 
-class DynamicPoseWindow(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
+class DynamicPoseWindow(
+    StreamableMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+):
     """Dynamic poses: the descriptors at ``t - s``, ``t``, ``t + s`` for every frame.
 
     For each frame ``t`` and each time step ``s`` in ``steps`` this concatenates
@@ -504,67 +507,27 @@ class DynamicPoseWindow(TransformerMixin, BaseEstimator, auto_wrap_output_keys=N
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
 
-    def stream_init(self, **options):
+    _stream_options = ()
+
+    def _stream_state(self):
         """A fresh state for one live stream (docs/design.md, "Incremental steps").
 
-        Parameters
-        ----------
-        **options
-            Options of other stages, ignored.
+        Descriptor rows in; the same rows out at once, with their lazy windows
+        (a :class:`DynamicPoses`, ``rows.info["windows"]``), the layout of
+        :meth:`transform` (``lazy=True``) on the block. The window of frame
+        ``u`` needs ``hw`` frames of future, and the classifier needs to know
+        that those frames are still in the period before it reads the window;
+        so :class:`MultiScaleClassifier` reads the windows of the centres it
+        scores from the ``DynamicPoses`` of its period. Dense windows of every
+        frame are never made.
 
         Returns
         -------
-        object
+        WindowStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._windows import WindowStream
-
         check_is_fitted(self)
-        return WindowStream(self)
-
-    def stream_step(self, state, rows):
-        """Descriptor rows in; the same rows out, as lazy windows.
-
-        The window of frame ``u`` needs ``hw`` frames of future, and the
-        classifier needs to know that those frames are still in the period
-        before it reads the window; so a stream builds windows where they are
-        read. The rows are handed on at once, tagged with ``steps`` and
-        ``n_poses``, and :class:`MultiScaleClassifier` builds the windows of
-        the centres it scores with :func:`dynamic_poses`, the function of
-        :meth:`transform`.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next descriptor rows (masked at rest).
-
-        Returns
-        -------
-        out : Rows
-            The same rows, tagged with the window layout.
-        state : object
-            The state.
-        """
-        return state.step(rows), state
-
-    def stream_flush(self, state):
-        """End of the stream: nothing is held back.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : None
-            No rows.
-        state : object
-            The state.
-        """
-        return state.flush(), state
+        return WindowStream(check_steps(self.steps, self.n_poses), self.n_poses)
 
     @property
     def stream_lookahead(self):
@@ -577,28 +540,35 @@ class DynamicPoseWindow(TransformerMixin, BaseEstimator, auto_wrap_output_keys=N
 
 
 class WindowStream:
-    """State of :meth:`DynamicPoseWindow.stream_step`: the descriptor rows, as
+    """State of :meth:`DynamicPoseWindow.stream_step`: the rows, with their
     lazy windows.
 
     A window centred at frame ``u`` needs the descriptors up to ``u + hw``,
     and the classifier needs to know whether frame ``u + hw`` is still in the
-    period before it scores that window. So in a stream the windows are built
-    where they are used: this stage hands the descriptor rows on at once,
-    tagged with its ``steps`` and ``n_poses`` (``rows.info["windows"]``), and
-    :class:`MultiScaleStream` builds the windows of the centres it scores with
-    :func:`~skgesture._windows.dynamic_poses`, the function of the offline
-    ``transform``. Dense windows of every frame are never made (the classifier
-    reads one window every ``stride`` frames of a period).
+    period before it scores that window. So this stage hands each block of
+    descriptor rows on at once with its :class:`DynamicPoses` (the layout of
+    the offline ``transform``, ``rows.info["windows"]``), and
+    :class:`~skgesture._multiscale._stream.MultiScaleStream` reads the windows
+    of the centres it scores from the ``DynamicPoses`` of its period. Dense
+    windows of every frame are never made (the classifier reads one window
+    every ``stride`` frames of a period).
+
+    Parameters
+    ----------
+    steps : tuple of int
+        Time step of each scale (checked).
+    n_poses : int
+        Descriptors per dynamic pose.
     """
 
-    def __init__(self, windows):
-        from skgesture._windows import check_steps
-
-        self.layout = (check_steps(windows.steps, windows.n_poses), windows.n_poses)
+    def __init__(self, steps, n_poses):
+        self.steps = tuple(steps)
+        self.n_poses = int(n_poses)
 
     def step(self, rows):
-        rows.info = {**(rows.info or {}), "windows": self.layout}
-        return rows
+        windows = DynamicPoses(rows.data, self.steps, self.n_poses, rest=rows.mask)
+        info = {**(rows.info or {}), "windows": windows}
+        return Rows(windows.descriptors, rows.mask, rows.time, info)
 
     def flush(self):
         return None

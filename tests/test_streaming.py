@@ -215,8 +215,8 @@ def test_streaming_agrees_with_offline_on_synthetic_streams():
 def test_descriptor_stream_gives_the_rows_of_transform(precog, monkeypatch, compiled):
     """The descriptor step equals the batch transform (to rounding), for every
     parameter of PoseDescriptor, one frame or a block at a time: with the
-    compiled kernel (the batch code on the frames a row needs) and without it
-    (the per-frame arithmetic of FrameDescriber against the numpy batch)."""
+    compiled kernel and without it (the numpy batch code): the stream runs the
+    descriptor's own batch code on the frames a row needs."""
     import skgesture._descriptor._compute as descriptor_module
 
     if compiled and descriptor_module._compiled_kernel() is None:
@@ -651,3 +651,66 @@ def test_invalid_pipelines_and_options(cheap_pipeline, precog):
     rec = StreamingRecognizer(fitted)
     assert rec.flush() == []  # nothing pushed: nothing to decide
     assert rec.push(np.zeros((20, 3))) == [] and rec.flush() == []
+
+
+# -- the protocol: options routed to the stages that declare them -----------------
+
+
+def test_each_stage_refuses_an_option_it_does_not_declare(cheap_pipeline):
+    desc = cheap_pipeline.named_steps["descriptor"]
+    assert desc._stream_options == ("max_backfill",)
+    desc.stream_init(max_backfill=3)  # its own option
+    with pytest.raises(TypeError, match="unknown option.*max_period.*max_backfill"):
+        desc.stream_init(max_period=100)
+    seg = cheap_pipeline.named_steps["segmenter"]
+    with pytest.raises(TypeError, match="early_decision; it takes no option"):
+        seg.stream_init(early_decision=True)
+
+
+def test_recogniser_routes_options_and_refuses_one_no_stage_takes(
+    cheap_pipeline, method_c
+):
+    rec = StreamingRecognizer(cheap_pipeline, max_period=300, max_backfill=5)
+    routed = dict(zip([name for name, _ in cheap_pipeline.steps], rec._options))
+    assert routed["descriptor"] == {"max_backfill": 5}
+    assert routed["segmenter"] == {} and routed["windows"] == {}
+    assert routed["classifier"] == {"max_period": 300, "early_decision": False}
+    # Method C has no stage that decides early: the option is an error, not
+    # silently ignored.
+    with pytest.raises(ValueError, match="early_decision=True is an option of no"):
+        StreamingRecognizer(method_c, early_decision=True)
+    assert dict(zip([n for n, _ in method_c.steps], StreamingRecognizer(
+        method_c, max_period=50)._options))["tagger"] == {"max_period": 50}  # fmt: skip
+
+
+def test_method_c_stream_enforces_max_period(method_c, precog):
+    """max_period bounds Method C's live runs (it was dropped before)."""
+    X = np.concatenate(_split(precog, TEST_SUBJECTS)[0])
+    offline = _offline(method_c, X)
+    longest = int(max(offline[:, 2] - offline[:, 1]))
+    cap = max(longest // 2, 2)
+    assert longest > cap  # the cap does cut
+    events = StreamingRecognizer(method_c, max_period=cap).recognize(X)
+    assert events and max(ev.end - ev.start for ev in events) <= cap
+
+
+def test_window_step_hands_on_the_offline_lazy_windows(cheap_pipeline, precog):
+    """DynamicPoseWindow's step hands on the DynamicPoses of transform, and
+    the offline transform is that step over the whole sequence."""
+    from skgesture._windows import DynamicPoses
+
+    pipe = cheap_pipeline
+    D = pipe[:2].transform([_split(precog, (1,))[0][0][:120]])[0]
+    win = pipe.named_steps["windows"]
+    state = win.stream_init()
+    rows = Rows(np.ma.getdata(D), np.ma.getmaskarray(D).any(axis=1),
+                np.arange(len(D)))  # fmt: skip
+    out, state = win.stream_step(state, rows)
+    lazy = out.info["windows"]
+    assert isinstance(lazy, DynamicPoses)
+    assert (lazy.steps, lazy.n_poses) == (tuple(win.steps), win.n_poses)
+    offline = win.set_params(lazy=True).transform([D])[0]
+    win.set_params(lazy=False)
+    np.testing.assert_array_equal(np.asarray(lazy), np.asarray(offline))
+    np.testing.assert_array_equal(lazy.rest_rows(), offline.rest_rows())
+    assert win.stream_flush(state)[0] is None

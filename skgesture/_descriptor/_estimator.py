@@ -39,6 +39,8 @@ from skgesture._descriptor._constants import (
     MIN_NORM,
     MIN_SCALE,
 )
+from skgesture._descriptor._stream import DescriptorStream
+from skgesture._stream import DEFAULT_MAX_BACKFILL, StreamableMixin
 from skgesture.layouts import (
     KINECT_V1,
     N_COORDS,
@@ -46,8 +48,7 @@ from skgesture.layouts import (
     get_descriptor_joints,
 )
 from skgesture.utils._validation import (
-    MAX_COORDINATE,
-    check_sequences,
+    check_skeletons,
     missing_frames,
     refuse_set_output,
 )
@@ -55,7 +56,9 @@ from skgesture.utils._validation import (
 __all__ = ["PoseDescriptor"]
 
 
-class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
+class PoseDescriptor(
+    StreamableMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+):
     """Per-frame handcrafted pose descriptor of Brás, Simão & Neto.
 
     Turns each skeleton sequence ``(n_frames, 20, 3)`` (Kinect v1 joint order, in
@@ -208,7 +211,7 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
         self : PoseDescriptor
             The fitted transformer.
         """
-        X = self._validate(X, reset=True)
+        X = check_skeletons(X, estimator=self, reset=True)
         spec = self._spec()
         self.joints_ = spec["joints"]
         links = spec["links"]
@@ -268,7 +271,7 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
         check_is_fitted(self)
         spec = self._spec()
         self._check_joints(spec)
-        X = self._validate(X, reset=False)
+        X = check_skeletons(X, estimator=self, reset=False)
         out = self._describe_all(X, spec, standardize=True)
         for i, seq in enumerate(X):
             rows = missing_frames(seq)
@@ -327,26 +330,6 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
         return np.asarray(names, dtype=object)
 
     # -- internals -------------------------------------------------------------
-
-    def _validate(self, X, reset):
-        if isinstance(X, (list, tuple)):
-            # A masked value marks an untracked joint: it becomes NaN, so its
-            # frame is untracked, whatever lies under the mask.
-            X = [
-                np.ma.filled(np.ma.asarray(seq, dtype=float), np.nan)
-                if isinstance(seq, np.ma.MaskedArray)
-                else seq
-                for seq in X
-            ]
-        return check_sequences(
-            X,
-            frame_shape=(KINECT_V1.n_joints, N_COORDS),
-            ndim=3,
-            allow_nan=True,
-            estimator=self,
-            reset=reset,
-            max_abs=MAX_COORDINATE,
-        )
 
     def _check_joints(self, spec):
         """Refuse a ``joints`` changed since ``fit`` (set_params on a fitted model)."""
@@ -514,11 +497,20 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
         return tags
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
-    # The state lives in skgesture/_descriptor/_stream.py (DescriptorStream);
-    # tests/test_streaming.py checks that a stream gives the rows of transform.
+    # StreamableMixin writes stream_init/step/flush; the state is
+    # DescriptorStream (skgesture/_descriptor/_stream.py), which computes rows
+    # with _describe_all, as transform does.
 
-    def stream_init(self, *, max_backfill=64, **options):
+    _stream_options = ("max_backfill",)
+
+    def _stream_state(self, *, max_backfill=DEFAULT_MAX_BACKFILL):
         """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Raw frames in, the descriptor rows that became final out: every frame
+        is checked as :meth:`transform` checks it (a bad one raises a
+        ``ValueError`` naming its stream index, the state unchanged);
+        untracked frames hold the last tracked frame (``fill="hold"``: the
+        future is unknown) and come out masked.
 
         Parameters
         ----------
@@ -526,12 +518,10 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
             Untracked frames at the start of a stream that wait for the first
             tracked frame and become copies of it, as offline filling does;
             earlier ones are handed on at once as rest (all-zero masked rows).
-        **options
-            Options of other stages, ignored.
 
         Returns
         -------
-        object
+        DescriptorStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
 
         Examples
@@ -549,58 +539,20 @@ class PoseDescriptor(TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
         >>> bool(abs(rows.data - desc.transform([X[:10]])[0][:6]).max() < 1e-12)
         True
         """
-        from skgesture._descriptor._stream import DescriptorStream
-
         check_is_fitted(self)
-        if hasattr(self, "_check_joints"):
-            self._check_joints(self._spec())
-        return DescriptorStream(self, max_backfill=max_backfill)
+        spec = self._spec()
+        self._check_joints(spec)
 
-    def stream_step(self, state, rows):
-        """Raw frames in; the descriptor rows that became final out.
+        def describe(seq):
+            return self._describe_all([seq], spec, standardize=True)[0]
 
-        Every frame is checked as :meth:`transform` checks it, and a bad one
-        raises a ``ValueError`` naming its index in the stream (the state is
-        then unchanged). Untracked frames hold the last tracked frame
-        (``fill="hold"``: the future is unknown) and come out masked.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next raw frames ``(n, 20, 3)``, with their stream indices as
-            ``time``.
-
-        Returns
-        -------
-        out : Rows
-            Descriptor rows ``(m, n_features_out_)``, masked where untracked.
-        state : object
-            The updated state.
-        """
-        from skgesture._stream import Rows
-        from skgesture.utils._validation import check_stream_frames
-
-        frames = check_stream_frames(self, rows.data, int(rows.time[0]))
-        return state.step(Rows(frames, rows.mask, rows.time)), state
-
-    def stream_flush(self, state):
-        """End of the stream: the last rows, with the offline end padding.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : Rows
-            The remaining rows.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
+        return DescriptorStream(
+            describe,
+            spec["joints"].n_features,
+            self.stream_lookahead,
+            self,
+            max_backfill=max_backfill,
+        )
 
     @property
     def stream_lookahead(self):

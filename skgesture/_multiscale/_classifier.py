@@ -27,8 +27,10 @@ from skgesture._multiscale._rules import (
     decide_period,
     period_windows,
 )
+from skgesture._multiscale._stream import MultiScaleStream
 from skgesture._nn._mlp import TorchMLPClassifier
 from skgesture._nn._training import fit_inner_estimator
+from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._windows import (
     N_POSES,
     STEPS_A,
@@ -84,7 +86,7 @@ def _guess_step(W, D, t, k, j, mid, F):
     return ""
 
 
-class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
+class MultiScaleClassifier(StreamableMixin, ClassifierMixin, BaseEstimator):
     """Dynamic-pose classifier at one or more time scales, with the paper's rules.
 
     Fits one clone of ``estimator`` per time scale on the windows of every
@@ -519,8 +521,18 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             lab, segs = _map_back(lab, segs, where)
         return segs
 
-    def stream_init(self, *, max_period=1200, early_decision=False, **options):
+    _stream_options = ("max_period", "early_decision")
+
+    def _stream_state(self, *, max_period=DEFAULT_MAX_PERIOD, early_decision=False):
         """A fresh state for one live stream (docs/design.md, "Incremental steps").
+
+        Descriptor rows (masked at rest) with their lazy windows in; the
+        gestures decided out. Periods are the runs of unmasked rows. The
+        window centred at ``c`` is scored once frame ``c + hw`` is known to be
+        in the period; a period is decided with the rules of :meth:`predict`
+        when it ends, and in a period known to be long a run of windows is
+        emitted as soon as no later window can change it (docs/streaming.md,
+        "Delay").
 
         Parameters
         ----------
@@ -533,62 +545,22 @@ class MultiScaleClassifier(ClassifierMixin, BaseEstimator):
             emitted without waiting ``short_length`` frames, and a period that
             ends short gets its majority vote only if nothing was emitted in
             it. Less delay, but the events may differ from ``predict``.
-        **options
-            Options of other stages, ignored.
 
         Returns
         -------
-        object
+        MultiScaleStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._multiscale._stream import MultiScaleStream
-
         check_is_fitted(self)
+        steps = self._check_steps()
         return MultiScaleStream(
-            self, max_period=max_period, early_decision=early_decision
+            self,
+            steps,
+            self._fusion_weights(len(steps)),
+            self._period_segments,
+            max_period=max_period,
+            early_decision=early_decision,
         )
-
-    def stream_step(self, state, rows):
-        """Descriptor rows (masked at rest) in; the gestures decided out.
-
-        Periods are the runs of unmasked rows. The window centred at ``c`` is
-        built and scored once frame ``c + hw`` is known to be in the period; a
-        period is decided with the rules of :meth:`predict` when it ends, and
-        in a period known to be long a run of windows is emitted as soon as
-        no later window can change it (docs/streaming.md, "Delay").
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next rows of a :class:`DynamicPoseWindow` stream step.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            ``(label, start, end, confidence, time)`` of each gesture decided.
-        state : object
-            The updated state.
-        """
-        return state.step(rows), state
-
-    def stream_flush(self, state):
-        """End of the stream: decide the open period.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            The remaining gestures.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
 
     @property
     def stream_lookahead(self):

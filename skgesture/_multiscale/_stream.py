@@ -10,7 +10,7 @@ import numpy as np
 from skgesture._nn._fast import fast_proba
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamSegment
 from skgesture._windows import (
-    dynamic_poses,
+    DynamicPoses,
 )
 from skgesture.utils._buffers import RowBuffer
 
@@ -22,7 +22,7 @@ class MultiScaleStream:
     the window centred at ``c`` (stride ``stride`` from its start + ``hw``) is
     built and scored as soon as row ``c + hw`` is known to be in the period. A
     period is decided when it closes (at the first masked row) with the
-    offline rule (:meth:`MultiScaleClassifier._period_segments`: the paper's
+    offline rule (``decide``, the classifier's ``_period_segments``: the paper's
     short and long rules, and the cubic resizing of a short period). In a
     period known to be long (``short_length`` frames), a run of windows is
     emitted as soon as no later window can change its frames (see
@@ -36,10 +36,17 @@ class MultiScaleStream:
     delay (docs/streaming.md, "Delay").
     """
 
-    def __init__(self, clf, max_period=DEFAULT_MAX_PERIOD, early_decision=False):
-        steps = clf._check_steps()
+    def __init__(
+        self,
+        clf,
+        steps,
+        fusion,
+        decide,
+        max_period=DEFAULT_MAX_PERIOD,
+        early_decision=False,
+    ):
         self.clf = clf
-        self.steps = steps
+        self.steps = tuple(steps)
         self.n_poses = clf.n_poses
         self.hw = max(steps) * (clf.n_poses - 1) // 2
         self.stride = clf.stride
@@ -47,7 +54,8 @@ class MultiScaleStream:
         # A period shorter than this has fewer than min_windows windows and is
         # resized (docs/method.md §5.3, period_windows).
         self.n_resize = 2 * self.hw + 1 + self.stride * (self.min_windows - 1)
-        self.fusion = clf._fusion_weights(len(steps))
+        self.fusion = fusion
+        self.decide = decide  # the offline decision of one period
         self.probas = [fast_proba(est) for est in clf.estimators_]
         self.classes = np.asarray(clf.classes_)
         self.short_length = clf.short_length
@@ -85,17 +93,17 @@ class MultiScaleStream:
         self.emitted = set()
 
     def step(self, rows):
-        layout = (rows.info or {}).get("windows")
-        if rows.data.ndim != 2 or layout is None:
+        windows = (rows.info or {}).get("windows")
+        if rows.data.ndim != 2 or not isinstance(windows, DynamicPoses):
             raise TypeError(
                 "MultiScaleClassifier streams after a DynamicPoseWindow stage, whose "
-                "stream step hands on the descriptor rows as lazy windows; got rows "
-                f"of shape {rows.data.shape[1:]}"
+                "stream step hands on the descriptor rows with their lazy windows; "
+                f"got rows of shape {rows.data.shape[1:]}"
             )
-        if layout != (self.steps, self.n_poses):
+        if (windows.steps, windows.n_poses) != (self.steps, self.n_poses):
             raise ValueError(
-                f"DynamicPoseWindow(steps={layout[0]}, n_poses={layout[1]}) does not "
-                f"match MultiScaleClassifier(steps={self.steps}, n_poses="
+                f"DynamicPoseWindow(steps={windows.steps}, n_poses={windows.n_poses}) "
+                f"does not match MultiScaleClassifier(steps={self.steps}, n_poses="
                 f"{self.n_poses}): use the same steps in both stages"
             )
         if self.rows is None:
@@ -137,6 +145,10 @@ class MultiScaleStream:
             self._close(u + 1, now)
             self._reset_period()
 
+    def _windows(self, D):
+        """The lazy windows of descriptor rows ``D`` of the period."""
+        return DynamicPoses(D, self.steps, self.n_poses)
+
     def _fused(self, wins):
         """Fused class scores of windows ``(n, n_scales, width)``, as offline."""
         return sum(
@@ -153,7 +165,7 @@ class MultiScaleStream:
             return
         centres = np.arange(self.next_centre, last + 1, stride)
         D = self.rows.data(centres[0] - hw, centres[-1] + hw + 1)
-        wins = dynamic_poses(D, self.steps, self.n_poses, centres - centres[0] + hw)
+        wins = self._windows(D).windows(centres - centres[0] + hw)
         scores = self._fused(wins)
         self.next_centre = int(centres[-1]) + stride
         best = np.argmax(scores, axis=1)
@@ -202,7 +214,7 @@ class MultiScaleStream:
 
     def _segments(self, scores, centres, length, resized=False, early=False):
         short = 0 if early else None  # early decision: the long-period rule
-        return self.clf._period_segments(
+        return self.decide(
             np.asarray(scores), np.asarray(centres), length, resized,
             short_length=short,
         )  # fmt: skip
@@ -242,7 +254,7 @@ class MultiScaleStream:
             scores, centres = self.scores, self.centres
         else:
             # Too short for min_windows windows: resized (docs/method.md §5.3).
-            W = dynamic_poses(self.rows.data(self.start, end), self.steps, self.n_poses)
+            W = self._windows(self.rows.data(self.start, end)).windows()
             wins, centres, resized = period_windows(
                 W, 0, length, self.steps, n_poses=self.n_poses,
                 stride=self.stride, min_windows=self.min_windows,

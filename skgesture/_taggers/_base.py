@@ -28,7 +28,9 @@ from skgesture._nn._training import (
     fit_cached,
     torch_threads,
 )
+from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._taggers._decoding import SMOOTHINGS, decode, segments_with_confidence
+from skgesture._taggers._stream import TrailingWindowStream
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -58,7 +60,7 @@ _STREAM_CONSTRAINTS = {
 }
 
 
-class _BaseTagger(ClassifierMixin, BaseEstimator):
+class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
     """Per-frame classifier of whole sequences, with one decoding path.
 
     Subclasses implement ``_network(n_classes)`` (an unfitted estimator whose
@@ -235,8 +237,17 @@ class _BaseTagger(ClassifierMixin, BaseEstimator):
     # no later frame can change). Subclasses with their own step (the chunked
     # BiLSTMTagger) override these methods.
 
-    def stream_init(self, *, max_period=1200, **options):
+    _stream_options = ("max_period",)
+
+    def _stream_state(self, *, max_period=DEFAULT_MAX_PERIOD):
         """A fresh state for one live stream (docs/design.md §4.1).
+
+        Feature rows in, the gestures decided out. The probabilities of frame
+        ``u`` are computed when frame ``u + stream_future`` arrives, from the
+        frames up to it (a window of ``stream_past`` frames before, or a
+        recurrent network's carried state), then smoothed and decoded with the
+        offline rules (:func:`skgesture._taggers._decoding.decode`); untracked
+        (masked) rows are rest.
 
         Parameters
         ----------
@@ -245,16 +256,12 @@ class _BaseTagger(ClassifierMixin, BaseEstimator):
             (one gesture, or runs of one class joined by short gaps) is
             decided as if the stream ended there, which bounds memory;
             offline has no such cap.
-        **options
-            Options of other stages, ignored.
 
         Returns
         -------
-        object
+        TrailingWindowStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._taggers._stream import TrailingWindowStream
-
         check_is_fitted(self)
         past = getattr(self, "stream_past", DEFAULT_STREAM_PAST)
         with torch_threads(getattr(self, "n_threads", None)):
@@ -271,49 +278,6 @@ class _BaseTagger(ClassifierMixin, BaseEstimator):
             max_run=max_period,
             owner=f"{type(self).__name__}.smooth_span",
         )
-
-    def stream_step(self, state, rows):
-        """Feature rows in; the gestures decided with them out.
-
-        The probabilities of frame ``u`` are computed when frame
-        ``u + stream_future`` arrives, from the frames up to it (a window of
-        ``stream_past`` frames before, or a recurrent network's carried
-        state), then smoothed and decoded with the offline rules
-        (:func:`skgesture._taggers._decoding.decode`); untracked (masked) rows are
-        rest.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next feature rows.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            ``(label, start, end, confidence, time)`` of each gesture decided.
-        state : object
-            The updated state.
-        """
-        return state.step(rows), state
-
-    def stream_flush(self, state):
-        """End of the stream: the last frames, end-point smoothing, last run.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            The remaining gestures.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
 
     @property
     def stream_lookahead(self):

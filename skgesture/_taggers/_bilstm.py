@@ -33,8 +33,10 @@ from skgesture._nn._training import (
     held_out_sequences,
     seed_from,
 )
+from skgesture._stream import DEFAULT_MAX_PERIOD
 from skgesture._taggers._base import _BaseTagger, _rest_where
 from skgesture._taggers._decoding import smooth_proba
+from skgesture._taggers._stream import TaggerStream
 from skgesture.utils._segments import _chunks
 from skgesture.utils._validation import SequenceOf
 
@@ -644,65 +646,29 @@ class BiLSTMTagger(_BaseTagger):
     # the chunks of predict_proba as they complete and applies the same loess,
     # rest rule and minimum run.
 
-    def stream_init(self, **options):
+    _stream_options = ("max_period",)
+
+    def _stream_state(self, *, max_period=DEFAULT_MAX_PERIOD):
         """A fresh state for one live stream (docs/design.md, "Incremental steps").
 
+        Descriptor rows in, the gestures decided out: the network runs on the
+        chunks of :meth:`predict_proba` as they complete, then the same
+        loess, rest rule and minimum run as :meth:`predict_segments`.
+
         Parameters
         ----------
-        **options
-            Options of other stages, ignored.
+        max_period : int, default=1200
+            A run of one label this long (frames) is decided as if the stream
+            ended there, which bounds memory on a stream that never rests
+            (offline has no cap).
 
         Returns
         -------
-        object
+        TaggerStream
             The state, for :meth:`stream_step` and :meth:`stream_flush`.
         """
-        from skgesture._taggers._stream import TaggerStream
-
         check_is_fitted(self)
-        return TaggerStream(self)
-
-    def stream_step(self, state, rows):
-        """Descriptor rows in; the gestures whose run ended out.
-
-        The network runs on each chunk of ``window`` frames as it completes
-        (the chunks of :meth:`predict_proba`), every class track is smoothed
-        by the causal loess, and a run of one gesture label of at least
-        ``min_run`` frames is emitted when the label changes. Untracked
-        (masked) rows are rest.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-        rows : Rows
-            The next descriptor rows.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            ``(label, start, end, confidence, time)`` of each gesture decided.
-        state : object
-            The updated state.
-        """
-        return state.step(rows), state
-
-    def stream_flush(self, state):
-        """End of the stream: the last chunks, end-point fits, the last run.
-
-        Parameters
-        ----------
-        state : object
-            From :meth:`stream_init`.
-
-        Returns
-        -------
-        out : list of StreamSegment
-            The remaining gestures.
-        state : object
-            The spent state.
-        """
-        return state.flush(), state
+        return TaggerStream(self, max_run=max_period)
 
     @property
     def stream_lookahead(self):

@@ -6,6 +6,7 @@ import numpy as np
 
 from skgesture._taggers._decoding import LabelRuns, make_smoother
 from skgesture.utils._buffers import RowBuffer
+from skgesture.utils._segments import _chunks
 from skgesture.utils._smoothing import LoessStepper
 
 
@@ -21,9 +22,7 @@ class TaggerStream:
     (:class:`LabelRuns`).
     """
 
-    def __init__(self, tagger):
-        from skgesture.utils._segments import _chunks
-
+    def __init__(self, tagger, max_run=None):
         self.tagger = tagger
         self.chunks = _chunks
         self.window = int(tagger.window)
@@ -35,7 +34,10 @@ class TaggerStream:
             tagger.smooth_span, n, owner="BiLSTMTagger.smooth_span"
         )
         self.runs = LabelRuns(
-            self.classes, tagger.min_run, max_gap=getattr(tagger, "max_gap", 0)
+            self.classes,
+            tagger.min_run,
+            max_gap=getattr(tagger, "max_gap", 0),
+            max_run=max_run,
         )
         self.D = None  # descriptor rows of the chunks to come
         self.raw = RowBuffer((n,), capacity=64)  # released probabilities

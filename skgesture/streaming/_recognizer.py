@@ -331,7 +331,10 @@ class StreamingRecognizer:
     def reset(self):
         """Forget the current stream (nothing is emitted)."""
         self.n_frames_seen = 0
-        self._states = [stage.stream_init(**self._options) for _, stage in self._stages]
+        self._states = [
+            stage.stream_init(**options)
+            for (_, stage), options in zip(self._stages, self._options)
+        ]
 
     def buffer_lengths(self):
         """Count the rows held by each stage's buffers.
@@ -351,6 +354,28 @@ class StreamingRecognizer:
         return out
 
     # -- set-up ----------------------------------------------------------------
+
+    def _route_options(self, stages):
+        """The options of each stage's ``stream_init``: each recogniser option
+        goes to the stages that declare it (``_stream_options``); one set away
+        from its default that no stage declares is an error."""
+        options = {
+            "max_period": (self.max_period, DEFAULT_MAX_PERIOD),
+            "max_backfill": (self.max_backfill, DEFAULT_MAX_BACKFILL),
+            "early_decision": (bool(self.early_decision), False),
+        }
+        declared = [tuple(getattr(stage, "_stream_options", ())) for _, stage in stages]
+        for key, (value, default) in options.items():
+            if value != default and not any(key in d for d in declared):
+                names = ", ".join(type(stage).__name__ for _, stage in stages)
+                raise ValueError(
+                    f"{key}={value!r} is an option of no stage of this pipeline "
+                    f"({names}); leave it at its default {default!r}"
+                )
+        return [
+            {key: value for key, (value, _) in options.items() if key in d}
+            for d in declared
+        ]
 
     def _inspect(self):
         """Check the pipeline and the options; read the stages' look-aheads."""
@@ -396,14 +421,10 @@ class StreamingRecognizer:
                 f"max_backfill must be a non-negative int, got {self.max_backfill!r}"
             )
         self._stages = stages
-        self._options = {
-            "max_period": self.max_period,
-            "max_backfill": self.max_backfill,
-            "early_decision": bool(self.early_decision),
-        }
+        self._options = self._route_options(stages)
         # Building the states checks the options against every stage.
-        for _, stage in stages:
-            stage.stream_init(**self._options)
+        for (_, stage), options in zip(stages, self._options):
+            stage.stream_init(**options)
         self.delays = {name: int(est.stream_lookahead) for name, est in stages}
         self.lookahead = sum(list(self.delays.values())[:-1])
         self.max_delay = sum(self.delays.values())

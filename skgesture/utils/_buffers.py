@@ -1,4 +1,4 @@
-"""Row buffers of a stream: rows addressed by stream index, running medians."""
+"""Buffers of a stream: rows by stream index, held raw frames, running medians."""
 
 # SPDX-License-Identifier: BSD-3-Clause
 
@@ -108,6 +108,86 @@ class RowBuffer:
         if d > 0:
             self._off += d
             self.start += d
+
+
+class HeldFrames:
+    """The raw frames of a stream, untracked ones held, leading ones backfilled.
+
+    The intake of every stage that reads raw skeletons live (``PoseDescriptor``,
+    ``JointFeatures``), one rule for both: an untracked frame repeats the last
+    tracked one (offline ``fill="hold"``: the future is unknown), and the
+    untracked frames that start a stream wait for the first tracked frame and
+    become copies of it, as offline filling does; only the last
+    ``max_backfill`` of them wait, earlier ones are handed on at once (as rest)
+    by the stage's ``hand_on``.
+
+    Parameters
+    ----------
+    max_backfill : int
+        Leading untracked frames that may wait for the first tracked one.
+    frame_shape : tuple, default=(20, 3)
+        Shape of one raw frame.
+
+    Attributes
+    ----------
+    frames : RowBuffer
+        The filled raw frames, from ``p0`` on.
+    p0 : int or None
+        First frame held (``None`` until a tracked frame arrives).
+    first_tracked : int or None
+        First tracked frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.utils._buffers import HeldFrames
+    >>> held = HeldFrames(max_backfill=1, frame_shape=(1,))
+    >>> x = np.array([[0.0], [0.0], [2.0], [0.0], [3.0]])
+    >>> handed = []
+    >>> out = held.push(x, x[:, 0] == 0, 0, 0, lambda until: handed.append(until))
+    >>> handed, held.p0, held.frames.data(1, 5)[:, 0].tolist()
+    ([1], 1, [2.0, 2.0, 2.0, 3.0])
+    """
+
+    def __init__(self, max_backfill, frame_shape=(20, 3)):
+        self.max_backfill = int(max_backfill)
+        self.frames = RowBuffer(frame_shape, capacity=32)
+        self.p0 = None
+        self.first_tracked = None
+        self.last = None  # the last tracked (or held) frame
+
+    def push(self, frames, untracked, first, n_out, hand_on):
+        """Append the next frames (``frames[0]`` is stream frame ``first``).
+
+        ``n_out`` is the stage's count of rows handed on; ``hand_on(until)``
+        hands on the leading frames before ``until`` as rest and returns its
+        output. Returns the list of those outputs (empty once tracking began).
+        """
+        out = []
+        if self.p0 is None:
+            if untracked.all():
+                out.append(hand_on(first + len(frames) - self.max_backfill))
+                return out
+            k = int(np.argmax(~untracked))
+            until = first + k - self.max_backfill
+            out.append(hand_on(until))
+            self.p0, self.first_tracked = max(n_out, until), first + k
+            self.frames.restart(self.p0)
+            # The leading frames kept back become copies of the first tracked one.
+            n_copies = self.first_tracked - self.p0
+            self.frames.append(np.repeat(frames[k : k + 1], n_copies, axis=0))
+            self.last = frames[k]
+            frames, untracked = frames[k:], untracked[k:]
+        if untracked.any():  # hold: an untracked frame repeats the last tracked one
+            frames = frames.copy()
+            src = np.maximum.accumulate(
+                np.where(~untracked, np.arange(len(frames)), -1)
+            )
+            frames[src < 0] = self.last
+            frames[src >= 0] = frames[src[src >= 0]]
+        self.last = frames[-1]
+        self.frames.append(frames)
+        return out
 
 
 def _concat_rows(parts, row_shape, dtype=np.float64):

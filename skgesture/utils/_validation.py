@@ -8,7 +8,6 @@ the frame and the expected shape, so a user can find the bad recording.
 # SPDX-License-Identifier: BSD-3-Clause
 
 import numbers
-import re
 
 import numpy as np
 from sklearn.utils._param_validation import Options
@@ -49,6 +48,7 @@ def check_sequences(
     dtype=np.float64,
     name="X",
     max_abs=MAX_ABS_VALUE,
+    first_frame=None,
 ):
     """Validate a list of sequences and return it as a list of float arrays.
 
@@ -80,6 +80,11 @@ def check_sequences(
         ``MAX_COORDINATE`` = 1e5 for raw coordinates). Values are checked
         before the cast to ``dtype``, so nothing overflows to ``inf`` silently
         (docs/design.md §1.2).
+    first_frame : int or None, default=None
+        Set for the frames pushed to a live stream (one sequence, the next
+        block): the stream index of its first frame. Messages then name the
+        offending frame by its stream index (``frame 37 of the stream is
+        invalid: ...``) instead of ``X[0] ... at frame 2``.
 
     Returns
     -------
@@ -110,10 +115,13 @@ def check_sequences(
     for i, seq in enumerate(X):
         if isinstance(seq, np.ma.MaskedArray):
             seq = seq.data
-        arr = _as_real_array(seq, f"{name}[{i}]")
+        where = f"{name}[{i}]"
+        if first_frame is not None:
+            where = f"frame {first_frame} of the stream is invalid: the block"
+        arr = _as_real_array(seq, where)
         if arr.ndim < 2:
             raise ValueError(
-                f"{name}[{i}] has shape {arr.shape}; expected (n_frames, ...) with "
+                f"{where} has shape {arr.shape}; expected (n_frames, ...) with "
                 f"at least 2 dimensions"
             )
         if ndim is not None and arr.ndim != ndim:
@@ -125,7 +133,7 @@ def check_sequences(
                 )
                 + ")"
             )
-            raise ValueError(f"{name}[{i}] has shape {arr.shape}; expected {expect}")
+            raise ValueError(f"{where} has shape {arr.shape}; expected {expect}")
         if frame_shape is not None:
             fs = tuple(frame_shape)
             ok = len(fs) == arr.ndim - 1 and all(
@@ -133,18 +141,16 @@ def check_sequences(
             )
             if not ok:
                 raise ValueError(
-                    f"{name}[{i}] has frames of shape {arr.shape[1:]}; expected "
+                    f"{where} has frames of shape {arr.shape[1:]}; expected "
                     f"{fs} (as seen in fit)"
                     if estimator is not None and not reset
-                    else f"{name}[{i}] has frames of shape {arr.shape[1:]}; "
-                    f"expected {fs}"
+                    else f"{where} has frames of shape {arr.shape[1:]}; expected {fs}"
                 )
         if arr.shape[0] < min_frames:
             raise ValueError(
-                f"{name}[{i}] has {arr.shape[0]} frames; at least {min_frames} "
-                f"are required"
+                f"{where} has {arr.shape[0]} frames; at least {min_frames} are required"
             )
-        _check_values(arr, f"{name}[{i}]", allow_nan, max_abs)
+        _check_values(arr, where, allow_nan, max_abs, first_frame)
         out.append(np.ascontiguousarray(arr, dtype=dtype))
     if estimator is not None and reset:
         estimator.frame_shape_in_ = tuple(out[0].shape[1:])
@@ -173,13 +179,14 @@ def _as_real_array(seq, where):
     return arr
 
 
-def _check_values(arr, where, allow_nan, max_abs):
+def _check_values(arr, where, allow_nan, max_abs, first_frame=None):
     """Raise a ValueError naming the frame of the first non-finite or absurd value.
 
     The common case costs two reductions and no temporary array: the minimum and
     the maximum are NaN if a NaN is present (``fmin``/``fmax`` skip NaN when NaN
     is allowed), infinite if an inf is, and beyond ``max_abs`` if any value is.
-    The offending frame is only looked for on error.
+    The offending frame is only looked for on error. With ``first_frame`` (a
+    live stream) the message names the frame by its stream index.
     """
     if arr.size == 0:
         return
@@ -207,14 +214,22 @@ def _check_values(arr, where, allow_nan, max_abs):
                     "skeletons, which PoseDescriptor fills (and masks)"
                 ),
             )
-        raise ValueError(
-            f"{where} contains {what} values (first at frame {frame}), e.g. "
-            f"{value}; {hint}"
+        if first_frame is None:
+            where, at = f"{where} contains", f" (first at frame {frame})"
+        else:
+            where = f"frame {first_frame + frame} of the stream is invalid: it contains"
+            at = ""
+        raise ValueError(f"{where} {what} values{at}, e.g. {value}; {hint}")
+    if first_frame is None:
+        where = f"{where} has the value {value:.4g} at frame {frame}"
+    else:
+        where = (
+            f"frame {first_frame + frame} of the stream is invalid: it has the "
+            f"value {value:.4g}"
         )
     raise ValueError(
-        f"{where} has the value {value:.4g} at frame {frame}, beyond the accepted "
-        f"magnitude {max_abs:.0e} (docs/design.md §1.2): check the units "
-        f"and the recording"
+        f"{where}, beyond the accepted magnitude {max_abs:.0e} "
+        f"(docs/design.md §1.2): check the units and the recording"
     )
 
 
@@ -453,7 +468,7 @@ def refuse_set_output(estimator, transform):
     )
 
 
-def check_skeletons(X, *, estimator=None, reset=True, name="X"):
+def check_skeletons(X, *, estimator=None, reset=True, name="X", first_frame=None):
     """Validate raw Kinect v1 skeleton sequences ``(n_frames_i, 20, 3)``.
 
     The input rule of every stage that reads raw skeletons: a masked value of a
@@ -472,6 +487,9 @@ def check_skeletons(X, *, estimator=None, reset=True, name="X"):
         Whether this call is a ``fit``.
     name : str, default="X"
         Name used in error messages.
+    first_frame : int or None, default=None
+        Stream index of the first frame, for frames pushed to a live stream
+        (see :func:`check_sequences`).
 
     Returns
     -------
@@ -506,29 +524,31 @@ def check_skeletons(X, *, estimator=None, reset=True, name="X"):
         reset=reset,
         max_abs=MAX_COORDINATE,
         name=name,
+        first_frame=first_frame,
     )
 
 
-def check_stream_frames(desc, frames, first):
-    """Validate pushed raw frames exactly as the stage's offline ``transform`` does.
+def check_stream_frames(frames, first, estimator):
+    """Validate raw frames pushed to a stream as offline input is validated.
 
-    ``desc`` is the first stage: a :class:`~skgesture.PoseDescriptor` (its own
-    ``_validate``) or any other stage reading raw skeletons, such as
-    :class:`~skgesture.JointFeatures` (``check_skeletons``, the rule both
-    share). Returns the frames as float64 ``(n, 20, 3)``; a bad frame raises a
-    ``ValueError`` naming its index in the stream.
+    The rule of :func:`check_skeletons` (every stage reading raw skeletons
+    shares it), on one block of frames whose first has stream index
+    ``first``: a bad frame raises a ``ValueError`` naming its stream index.
+
+    Parameters
+    ----------
+    frames : array-like of shape (n, 20, 3)
+        The next raw frames; masked values mark untracked joints.
+    first : int
+        Stream index of ``frames[0]``.
+    estimator : estimator
+        The fitted first stage (its ``frame_shape_in_`` is enforced).
+
+    Returns
+    -------
+    ndarray of shape (n, 20, 3)
+        float64, NaN where a joint is untracked.
     """
-    if isinstance(frames, np.ma.MaskedArray):
-        frames = np.ma.filled(np.ma.asarray(frames, dtype=float), np.nan)
-    try:
-        if hasattr(desc, "_validate"):
-            return desc._validate([frames], reset=False)[0]
-        from skgesture.utils._validation import check_skeletons
-
-        return check_skeletons([frames], estimator=desc, reset=False)[0]
-    except ValueError as exc:
-        msg = str(exc)
-        match = re.search(r"at frame (\d+)|\(frame (\d+)\)", msg)
-        k = int(next(g for g in match.groups() if g is not None)) if match else 0
-        msg = re.sub(r"^X\[0\] ", "", msg)
-        raise ValueError(f"frame {first + k} of the stream is invalid: {msg}") from None
+    return check_skeletons(
+        [frames], estimator=estimator, reset=False, first_frame=int(first)
+    )[0]
