@@ -26,6 +26,7 @@ from skgesture.metrics import (  # noqa: E402
     frame_accuracy,
     jaccard_index,
     jaccard_index_segments,
+    per_class_report,
 )
 from skgesture.utils._segments import labels_to_segments  # noqa: E402
 
@@ -140,6 +141,38 @@ def test_evaluate_json_matches_the_api(model_b, held_out, capsys):
     rest = scores["per_class"][0]
     assert rest["name"] == "rest"
     assert rest["frames"] == sum(int((y == 0).sum()) for y in held_out.y)
+
+
+def test_evaluate_per_class_table_is_the_metrics_report(model_b, held_out, capsys):
+    """The per-class rows (JSON and text) are skgesture.metrics.per_class_report."""
+    status, out, err = run(["evaluate", model_b, *HELD_OUT, "--json", "-q"], capsys)
+    assert status == 0, err
+    rows = json.loads(out)["per_class"]
+    pred = load_model(model_b).predict(held_out.X)
+    report = per_class_report(held_out.y, pred, labels=[0, 1, 2, 3])
+    assert [row["class"] for row in rows] == report.labels.tolist()
+    assert [row["frames"] for row in rows] == report.support.tolist()
+    for key in ("precision", "recall", "f1"):
+        assert [row[key] for row in rows] == report[key].tolist(), key
+    assert [row["gestures_true"] for row in rows] == [
+        None,
+        *report.true_gestures[1:].tolist(),
+    ]
+    assert [row["gestures_predicted"] for row in rows] == [
+        None,
+        *report.predicted_gestures[1:].tolist(),
+    ]
+    status, out, err = run(["evaluate", model_b, *HELD_OUT, "-q"], capsys)
+    assert status == 0, err
+    table = out.splitlines()[out.splitlines().index("") + 2 :]
+    assert len(table) == len(rows)
+    for line, k in zip(table, range(len(report.labels))):
+        values = line.split()
+        assert int(values[0]) == report.labels[k]
+        assert int(values[2]) == report.support[k]
+        assert [float(v) for v in values[3:6]] == pytest.approx(
+            [report.precision[k], report.recall[k], report.f1[k]], abs=5e-4
+        )
 
 
 def test_evaluate_prints_a_table(model_b, capsys):

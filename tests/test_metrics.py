@@ -25,6 +25,7 @@ from skgesture.metrics import (
     labels_to_segments,
     make_jaccard_scorer,
     make_sequence_scorer,
+    per_class_report,
     segmental_f1,
     segments_to_labels,
 )
@@ -327,6 +328,101 @@ def test_frame_confusion_matrix_counts_pooled_frames_in_label_order():
     assert_allclose(
         frame_confusion_matrix(y_true, y_pred, normalize="true")[1], [0.5, 0.5, 0]
     )
+
+
+# ------------------------------------------------------------- per-class report
+
+
+def test_per_class_report_hand_computed():
+    # Pooled frames: rest 2/3 precision, 2/2 recall; class 1 is predicted on
+    # frames 1 and 5 (1 right) and is 2 frames; class 2 is predicted once, right.
+    y_true = [np.array([0, 1, 1, 0]), np.array([2, 2])]
+    y_pred = [np.array([0, 1, 0, 0]), np.array([2, 1])]
+    report = per_class_report(y_true, y_pred)
+    assert_array_equal(report.labels, [0, 1, 2])
+    assert_array_equal(report.support, [2, 2, 2])
+    assert_allclose(report.precision, [2 / 3, 1 / 2, 1])
+    assert_allclose(report.recall, [1, 1 / 2, 1 / 2])
+    assert_allclose(report.f1, [0.8, 0.5, 2 / 3])
+    assert_array_equal(report.true_gestures, [0, 1, 1])
+    assert_array_equal(report.predicted_gestures, [0, 2, 1])
+    for key in ("labels", "support", "true_gestures", "predicted_gestures"):
+        assert report[key].dtype == np.int64
+
+
+def test_per_class_report_equals_scikit_learn_on_pooled_frames():
+    from sklearn.metrics import precision_recall_fscore_support
+
+    rng = np.random.default_rng(0)
+    y_true = [rng.integers(0, 4, n) for n in (30, 1, 17)]
+    y_pred = [rng.integers(0, 5, len(y)) for y in y_true]
+    # Every label, more than every label, and a subset in another order.
+    for labels in (None, [0, 1, 2, 3, 4, 7], [3, 0, 7]):
+        report = per_class_report(y_true, y_pred, labels=labels)
+        expected = (
+            np.unique(np.concatenate(y_true + y_pred)) if labels is None else labels
+        )
+        p, r, f, support = precision_recall_fscore_support(
+            np.concatenate(y_true),
+            np.concatenate(y_pred),
+            labels=expected,
+            zero_division=0,
+        )
+        assert_array_equal(report.labels, expected)
+        assert_allclose(report.precision, p)
+        assert_allclose(report.recall, r)
+        assert_allclose(report.f1, f)
+        assert_array_equal(report.support, support)
+
+
+def test_per_class_report_undefined_scores_are_zero_without_warning():
+    # Class 3 is never predicted (precision 0/0), class 4 never true (recall
+    # 0/0), class 5 is in neither (everything 0/0).
+    y_true = [np.array([0, 3, 3, 0])]
+    y_pred = [np.array([0, 0, 4, 0])]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        report = per_class_report(y_true, y_pred, labels=[3, 4, 5])
+    assert_array_equal(report.precision, [0, 0, 0])
+    assert_array_equal(report.recall, [0, 0, 0])
+    assert_array_equal(report.f1, [0, 0, 0])
+    assert_array_equal(report.support, [2, 0, 0])
+    assert_array_equal(report.true_gestures, [1, 0, 0])
+    assert_array_equal(report.predicted_gestures, [0, 1, 0])
+
+
+def test_per_class_report_counts_gestures_as_runs_of_the_listed_labels():
+    # Two touching runs of different classes are two gestures; a run of an
+    # unlisted class is not counted anywhere.
+    y_true = [np.array([1, 1, 2, 2, 0, 1]), np.array([3, 3])]
+    y_pred = [np.array([1, 0, 1, 2, 2, 2]), np.array([0, 0])]
+    report = per_class_report(y_true, y_pred, labels=[2, 1])
+    assert_array_equal(report.true_gestures, [1, 2])
+    assert_array_equal(report.predicted_gestures, [1, 2])
+
+
+@pytest.mark.parametrize(
+    "labels, match",
+    [
+        ([[0, 1]], "1-D"),
+        ([], "non-empty"),
+        (["a", "b"], "integers"),
+        ([0.5, 1], "integers"),
+        ([1, 2, 1], r"\[1\] more than once"),
+    ],
+)
+def test_per_class_report_rejects_bad_labels(labels, match):
+    with pytest.raises(ValueError, match=match):
+        per_class_report([[0, 1, 2]], [[0, 1, 1]], labels=labels)
+
+
+def test_per_class_report_validates_the_label_pairs():
+    with pytest.raises(ValueError, match="sequences"):
+        per_class_report([[0, 1]], [[0, 1], [1]])
+    with pytest.raises(ValueError, match="at least one frame"):
+        per_class_report([[]], [[]])
+    with pytest.raises(ValueError, match="at least one sequence"):
+        per_class_report([], [], labels=[0, 1])
 
 
 # ---------------------------------------------------------------- segmental F1

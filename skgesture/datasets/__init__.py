@@ -18,6 +18,7 @@ from skgesture.datasets._chalearn import (
     read_chalearn_labels,
     write_chalearn_predictions,
 )
+from skgesture.datasets._intervals import read_intervals, write_intervals
 from skgesture.datasets._others import (
     MSR_ACTION3D_ACTION_NAMES,
     MSRC12_GESTURE_NAMES,
@@ -27,12 +28,8 @@ from skgesture.datasets._others import (
     load_utkinect,
 )
 from skgesture.datasets._precog import PRECOG_ACTION_NAMES, load_precog
-from skgesture.datasets._recordings import (
-    load_recordings,
-    read_intervals,
-    read_skeleton_csv,
-    write_intervals,
-)
+from skgesture.datasets._recordings import load_recordings
+from skgesture.datasets._skeleton_csv import read_skeleton_csv
 from skgesture.datasets._synthetic import make_gesture_streams
 from skgesture.layouts import MSR_ACTION3D_TO_KINECT_V1
 

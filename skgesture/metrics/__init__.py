@@ -2,7 +2,8 @@
 
 The ChaLearn LAP 2014 Jaccard index exactly as the official script computes it
 (with the penalised and inclusive variants of docs/method.md §2.3), frame accuracy,
-the frame confusion matrix, the segmental F1@k and edit scores of temporal action
+the frame confusion matrix, the per-class report (frame precision, recall and F1,
+gestures found), the segmental F1@k and edit scores of temporal action
 segmentation, and scorers for ``GridSearchCV``.
 """
 
@@ -20,6 +21,7 @@ from skgesture.metrics._segmental import (
     edit_score,
     frame_accuracy,
     frame_confusion_matrix,
+    per_class_report,
     segmental_f1,
 )
 from skgesture.utils._segments import labels_to_segments, segments_to_labels
@@ -29,6 +31,7 @@ __all__ = [
     "jaccard_index_segments",
     "frame_accuracy",
     "frame_confusion_matrix",
+    "per_class_report",
     "segmental_f1",
     "edit_score",
     "jaccard_scorer",

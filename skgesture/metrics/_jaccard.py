@@ -250,11 +250,19 @@ def jaccard_index_segments(
     return score
 
 
+def _segments_to_lines(seg):
+    """File lines of segments: 1-based start, inclusive end (rows modified in place).
+
+    A 0-based start becomes 1-based; the exclusive 0-based end is already the
+    1-based number of the last frame.
+    """
+    seg[:, 1] += 1
+    return seg
+
+
 def _labels_to_lines(y):
     """File lines of a per-frame labelling: one per maximal gesture run (§1.7)."""
-    seg = labels_to_segments(y, rest=REST)
-    seg[:, 1] += 1  # 0-based start -> 1-based; the exclusive end is the 1-based last
-    return seg
+    return _segments_to_lines(labels_to_segments(y, rest=REST))
 
 
 def _true_segment_lines(true_segments, y_true):
@@ -274,8 +282,7 @@ def _true_segment_lines(true_segments, y_true):
     lines = []
     for i, (seg, yt) in enumerate(zip(true_segments, y_true)):
         seg = check_segments(seg, len(yt), name=f"true_segments[{i}]")
-        seg[:, 1] += 1  # 0-based start -> 1-based; the exclusive end is the last
-        lines.append(seg)
+        lines.append(_segments_to_lines(seg))
     return lines
 
 

@@ -1,9 +1,9 @@
 """Frame-level and segment-level metrics for per-frame label sequences.
 
-Frame accuracy and the frame confusion matrix pool every frame of every sequence.
-The segmental F1@k and edit score are the temporal-action-segmentation standard
-(Lea et al. 2017; MS-TCN, Farha & Gall 2019): rest (label 0) is background and
-forms no segment.
+Frame accuracy, the frame confusion matrix and the per-class report pool every
+frame of every sequence. The segmental F1@k and edit score are the
+temporal-action-segmentation standard (Lea et al. 2017; MS-TCN, Farha & Gall
+2019): rest (label 0) is background and forms no segment.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -14,6 +14,7 @@ import warnings
 import numpy as np
 from sklearn.exceptions import UndefinedMetricWarning
 from sklearn.metrics import confusion_matrix
+from sklearn.utils import Bunch
 
 from skgesture.utils._segments import labels_to_segments
 from skgesture.utils._validation import check_sequence_labels
@@ -21,6 +22,7 @@ from skgesture.utils._validation import check_sequence_labels
 __all__ = [
     "frame_accuracy",
     "frame_confusion_matrix",
+    "per_class_report",
     "segmental_f1",
     "edit_score",
 ]
@@ -180,6 +182,129 @@ def frame_confusion_matrix(y_true, y_pred, labels=None, *, normalize=None):
     if labels is None and flat_true.size == 0:
         raise ValueError("frame_confusion_matrix needs at least one frame")
     return confusion_matrix(flat_true, flat_pred, labels=labels, normalize=normalize)
+
+
+def _check_report_labels(labels):
+    """The ``labels`` of a report as int64: 1-D, non-empty, unique integers."""
+    arr = np.asarray(labels)
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError(
+            f"labels must be a non-empty 1-D array of class labels, got shape "
+            f"{arr.shape}"
+        )
+    if arr.dtype == bool or not np.issubdtype(arr.dtype, np.number):
+        raise ValueError(f"labels must hold integers, got dtype {arr.dtype}")
+    if not np.issubdtype(arr.dtype, np.integer) and not (
+        np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))
+    ):
+        raise ValueError(f"labels must hold integers, got {arr.tolist()!r}")
+    arr = arr.astype(np.int64)
+    values, counts = np.unique(arr, return_counts=True)
+    if np.any(counts > 1):
+        raise ValueError(f"labels lists {values[counts > 1].tolist()} more than once")
+    return arr
+
+
+def per_class_report(y_true, y_pred, *, labels=None):
+    """Per-class frame precision, recall and F1, with the gestures of each class.
+
+    Every frame of every sequence is pooled, as in
+    :func:`frame_confusion_matrix`: for class ``c``, precision is the fraction
+    of the frames predicted ``c`` that are ``c``, recall the fraction of the
+    frames of ``c`` predicted ``c``. Beside them the report counts the
+    gestures (maximal runs of one gesture label, as in :func:`segmental_f1`)
+    of each class in the truth and in the prediction, which shows over- and
+    under-segmentation that the frame scores hide.
+
+    Parameters
+    ----------
+    y_true : list of array-like of shape (n_frames_i,)
+        True per-frame labels, 0 = rest, 1..K gesture classes.
+    y_pred : list of array-like of shape (n_frames_i,)
+        Predicted per-frame labels.
+    labels : array-like of shape (n_labels,), default=None
+        The classes to report, in this order (rest, 0, may be one of them).
+        ``None`` uses every label present in ``y_true`` or ``y_pred``, sorted
+        (rest first). A label that no frame has gets zeros.
+
+    Returns
+    -------
+    :class:`~sklearn.utils.Bunch`
+        Dictionary-like object with keys, each an ndarray of shape
+        ``(n_labels,)`` in the order of ``labels``:
+
+        labels : ndarray of int64
+            The classes.
+        precision, recall, f1 : ndarray of float64
+            Frame precision, recall and their harmonic mean, in [0, 1].
+        support : ndarray of int64
+            Frames of each class in ``y_true``.
+        true_gestures, predicted_gestures : ndarray of int64
+            Gestures of each class in ``y_true`` and in ``y_pred``; always 0
+            for rest, which forms no gesture.
+
+    See Also
+    --------
+    frame_confusion_matrix : The counts the frame scores come from.
+    sklearn.metrics.precision_recall_fscore_support : The frame scores alone,
+        on flat label arrays.
+    segmental_f1 : Gestures matched by overlap rather than counted.
+
+    Notes
+    -----
+    An undefined score is 0, without a warning (``zero_division=0`` in
+    scikit-learn's terms): precision when no frame is predicted ``c``, recall
+    when no frame is ``c``, and F1 when no frame of ``c`` is predicted right.
+    ``skgesture evaluate`` prints this report as its per-class table.
+
+    Examples
+    --------
+    >>> from skgesture.metrics import per_class_report
+    >>> report = per_class_report([[0, 1, 1, 0, 2, 2]], [[0, 1, 0, 0, 2, 1]])
+    >>> report.labels.tolist(), report.support.tolist()
+    ([0, 1, 2], [2, 2, 2])
+    >>> report.precision.round(3).tolist(), report.recall.tolist()
+    ([0.667, 0.5, 1.0], [1.0, 0.5, 0.5])
+    >>> report.f1.round(3).tolist()
+    [0.8, 0.5, 0.667]
+    >>> report.true_gestures.tolist(), report.predicted_gestures.tolist()
+    ([0, 1, 1], [0, 2, 1])
+    """
+    y_true, y_pred = _check_label_pairs(y_true, y_pred)
+    if sum(len(yt) for yt in y_true) == 0:
+        raise ValueError("per_class_report needs at least one frame")
+    present = np.unique(np.concatenate([*y_true, *y_pred]))
+    labels = present if labels is None else _check_report_labels(labels)
+    # Count over every label, listed or not, so that a frame of a listed class
+    # predicted as an unlisted one still counts in its support.
+    every = np.union1d(present, labels)
+    cm = frame_confusion_matrix(y_true, y_pred, labels=every)
+    rows = np.searchsorted(every, labels)
+    tp = np.diag(cm)[rows]
+    support = cm.sum(axis=1)[rows]
+    predicted = cm.sum(axis=0)[rows]
+    zeros = np.zeros(len(labels))
+    precision = np.divide(tp, predicted, out=zeros.copy(), where=predicted > 0)
+    recall = np.divide(tp, support, out=zeros.copy(), where=support > 0)
+    f1 = np.divide(
+        2 * precision * recall, precision + recall, out=zeros.copy(), where=tp > 0
+    )
+    index = {int(c): k for k, c in enumerate(labels)}
+    counts = np.zeros((2, len(labels)), dtype=np.int64)
+    for row, sequences in enumerate((y_true, y_pred)):
+        for y in sequences:
+            for c in labels_to_segments(y, rest=REST)[:, 0].tolist():
+                if c in index:
+                    counts[row, index[c]] += 1
+    return Bunch(
+        labels=labels,
+        precision=precision,
+        recall=recall,
+        f1=f1,
+        support=support.astype(np.int64),
+        true_gestures=counts[0],
+        predicted_gestures=counts[1],
+    )
 
 
 def segmental_f1(y_true, y_pred, *, overlap=0.1):

@@ -1,0 +1,394 @@
+"""The subcommands of the ``skgesture`` command line: one ``cmd_*`` function each.
+
+Each takes the parsed arguments and returns the exit status; a user mistake
+raises :class:`~skgesture._cli_support.UsageError`. The parser that routes to
+them and ``main`` are in :mod:`skgesture._cli`.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from skgesture._cli_support import (
+    UsageError,
+    _class_name,
+    _fps,
+    _info,
+    _load_data,
+    _load_model,
+    _loader_verbose,
+    _make_model,
+    _n_frames,
+    _parse_subjects,
+    _predict,
+    _print_scores,
+    _progress,
+    _scores,
+    _select_subjects,
+    _target_names,
+)
+
+__all__ = [
+    "cmd_train",
+    "cmd_evaluate",
+    "cmd_predict",
+    "cmd_plot",
+    "cmd_stream",
+    "cmd_demo",
+]
+
+DEMO_TRAIN_SUBJECTS = "1-6"  # PRECOG subjects of the demo's training set
+DEMO_TEST_SUBJECTS = "7-8"
+ROBOT_REFRACTORY_FRAMES = 20  # one gesture, one command (examples/robot_...)
+
+
+# -- subcommands -------------------------------------------------------------------
+
+
+def cmd_train(args):
+    from skgesture._persistence import save_model
+
+    output = Path(args.output).expanduser()
+    if output.exists() and not args.overwrite:
+        raise UsageError(f"{output} exists; pass --overwrite to replace it")
+    data, kind, name = _load_data(args, need_labels=True)
+    verbose = 0 if args.quiet else 1
+    pipe = _make_model(args, verbose)
+    _info(
+        args,
+        f"training method {args.method} on {name}: {len(data.X)} sequences, "
+        f"{_n_frames(data):,} frames",
+    )
+    start = time.perf_counter()
+    pipe.fit(data.X, data.y)
+    seconds = time.perf_counter() - start
+    metadata = {
+        "method": args.method,
+        "data": args.data,
+        "data_kind": kind,
+        "subjects": args.subjects,
+        "n_sequences": len(data.X),
+        "n_frames": _n_frames(data),
+        "target_names": _target_names(data),
+        "fps": _fps(data),
+        "seed": args.seed,
+        "fit_seconds": round(seconds, 1),
+    }
+    save_model(pipe, output, metadata=metadata, overwrite=True)
+    print(f"trained method {args.method} in {seconds:.1f} s; model written to {output}")
+    return 0
+
+
+def cmd_evaluate(args):
+    data, kind, name = _load_data(args, need_labels=True)
+    model, info = _load_model(args, data)
+    names = _target_names(data, info)
+    y_pred = _predict(args, model, data.X)
+    scores = _scores(data, kind, y_pred, names)
+    meta = info.get("metadata") or {}
+    if args.json:
+        out = {
+            "model": str(args.model),
+            "method": meta.get("method"),
+            "data": args.data,
+            "subjects": args.subjects,
+            **scores,
+        }
+        print(json.dumps(out, indent=2))
+    else:
+        method = meta.get("method", "?")
+        _print_scores(scores, f"model {args.model} (method {method}) on {name}")
+    return 0
+
+
+def _write_frames(path, labels, overwrite):
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --overwrite to replace it")
+    rows = "".join(f"{t},{int(v)}\n" for t, v in enumerate(labels))
+    path.write_text("frame,label\n" + rows)
+    return path
+
+
+def cmd_predict(args):
+    data, kind, name = _load_data(args, need_labels=False)
+    model, info = _load_model(args, data)
+    out = Path(args.output).expanduser()
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--output {out} is a file; give a folder")
+    fmt = args.predict_format
+    if fmt == "auto":
+        fmt = "chalearn" if kind == "chalearn" else "intervals"
+    if fmt == "chalearn" and kind != "chalearn":
+        raise UsageError("--format chalearn needs ChaLearn input (sample ids)")
+    ids = [str(s) for s in data.sample_ids]
+    suffix = {
+        "chalearn": "_prediction.csv",
+        "intervals": ".labels.csv",
+        "frames": ".frames.csv",
+    }[fmt]
+    targets = [Path(f"{out / sid}{suffix}") for sid in ids]
+    existing = [p for p in targets if p.exists()]
+    if existing and not args.overwrite:
+        more = f" (and {len(existing) - 1} more)" if len(existing) > 1 else ""
+        raise UsageError(f"{existing[0]} exists{more}; pass --overwrite to replace")
+    y_pred = _predict(args, model, data.X)
+    out.mkdir(parents=True, exist_ok=True)
+    if fmt == "chalearn":
+        from skgesture.datasets import write_chalearn_predictions
+
+        paths = write_chalearn_predictions(
+            y_pred, ids, out, n_frames=data.get("n_frames"), overwrite=args.overwrite
+        )
+    else:
+        from skgesture.datasets import write_intervals
+
+        names = _target_names(data, info)
+        if names:
+            (out / "classes.txt").write_text("".join(f"{n}\n" for n in names))
+        paths = []
+        for path, labels in zip(targets, y_pred):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if fmt == "intervals":
+                paths.append(write_intervals(path, labels, overwrite=args.overwrite))
+            else:
+                paths.append(_write_frames(path, labels, args.overwrite))
+    from skgesture.utils._segments import labels_to_segments
+
+    n_gestures = sum(len(labels_to_segments(p)) for p in y_pred)
+    print(
+        f"wrote {len(paths)} {fmt} prediction file(s) to {out}: {n_gestures} "
+        f"gestures found in {len(y_pred)} sequences"
+    )
+    return 0
+
+
+def _sequence_index(data, spec):
+    ids = [str(s) for s in data.sample_ids]
+    if spec in ids:
+        return ids.index(spec)
+    try:
+        i = int(spec)
+    except ValueError:
+        raise UsageError(
+            f"--sequence {spec!r}: neither an index nor a sample id (e.g. {ids[0]!r})"
+        ) from None
+    if not 0 <= i < len(ids):
+        raise UsageError(f"--sequence {i}: the data has sequences 0..{len(ids) - 1}")
+    return i
+
+
+def cmd_plot(args):
+    output = Path(args.output).expanduser()
+    if output.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise UsageError(f"--output {output}: give a .png, .svg or .pdf file name")
+    if output.exists() and not args.overwrite:
+        raise UsageError(f"{output} exists; pass --overwrite to replace it")
+    try:
+        import matplotlib
+    except ImportError:
+        raise ImportError(
+            "plotting needs matplotlib: pip install skgesture[plot]"
+        ) from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from skgesture import plotting
+
+    kind = args.kind
+    need_model = kind != "skeleton"
+    if need_model and not args.model:
+        raise UsageError(f"plot {kind} needs --model MODEL")
+    data, data_kind, name = _load_data(args, need_labels=kind != "skeleton")
+    fps = _fps(data)
+    i = _sequence_index(data, args.sequence)
+    sid = str(data.sample_ids[i])
+    if kind == "skeleton":
+        x = np.asarray(data.X[i])
+        frame = args.frame if args.frame is not None else len(x) // 2
+        if not 0 <= frame < len(x):
+            raise UsageError(f"--frame {frame}: {sid} has frames 0..{len(x) - 1}")
+        ax = plotting.plot_skeleton(
+            x[frame], view=args.view, title=f"{sid}, frame {frame}"
+        )
+    else:
+        model, info = _load_model(args, data)
+        names = _target_names(data, info)
+        if kind == "segmentation":
+            ax = plotting.plot_segmentation(
+                model,
+                data.X[i],
+                data.y[i],
+                fps=fps,
+                target_names=names,
+                title=f"{sid}: activity segmentation",
+            )
+        else:
+            n = len(data.X) if kind == "confusion" else args.max_sequences
+            X, y = data.X[:n], data.y[:n]
+            y_pred = _predict(args, model, X)
+            if kind == "confusion":
+                ax = plotting.plot_confusion_matrix(
+                    y, y_pred, target_names=names, title=f"frame confusions, {name}"
+                )
+            else:
+                ax = plotting.plot_timelines(
+                    y,
+                    y_pred,
+                    sample_ids=[str(s) for s in data.sample_ids[:n]],
+                    target_names=names,
+                    fps=fps,
+                    title=f"truth against prediction, {name}",
+                )
+    fig = ax.figure
+    fig.tight_layout()
+    output.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(output, dpi=args.dpi)
+    plt.close(fig)
+    print(f"{kind} figure written to {output}")
+    return 0
+
+
+def _robot_mapping(args, recognizer):
+    from skgesture.streaming import RobotCommand
+
+    commands = list(RobotCommand)
+    if args.commands:
+        classes = [int(c) for c in _parse_subjects(args.commands)]
+    else:
+        classes = [int(c) for c in recognizer.classes_ if c != 0][: len(commands)]
+    if len(classes) != len(commands):
+        raise UsageError(
+            f"--commands needs {len(commands)} gesture classes (one per command: "
+            f"{', '.join(map(str, commands))}), got {len(classes)}"
+        )
+    return dict(zip(classes, commands))
+
+
+def cmd_stream(args):
+    from skgesture.streaming import StreamingRecognizer
+
+    data, _, name = _load_data(args, need_labels=False)
+    model, info = _load_model(args, data)
+    i = _sequence_index(data, args.sequence)
+    stream = np.asarray(data.X[i])
+    fps = args.fps or _fps(data) or 30.0
+    names = _target_names(data, info)
+    recognizer = StreamingRecognizer(model, target_names=names)
+    commander = robot = None
+    if args.robot:
+        from skgesture.streaming import ActionMap, GestureCommander, SimulatedRobot
+
+        mapping = _robot_mapping(args, recognizer)
+        action_map = ActionMap(
+            mapping,
+            min_confidence=args.min_confidence,
+            refractory_frames=ROBOT_REFRACTORY_FRAMES,
+        )
+        robot = SimulatedRobot()
+        commander = GestureCommander(recognizer, action_map, robot)
+        for cls, command in mapping.items():
+            _info(args, f"  gesture {_class_name(cls, names)} -> {command}")
+    print(
+        f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at "
+        f"{fps:g} fps (events come at most {recognizer.max_delay} frames after "
+        f"a gesture ends)"
+    )
+    bar = _progress(args, range(len(stream)), "frames", unit="frame")
+    write = print
+    if not args.quiet:
+        from tqdm.auto import tqdm
+
+        write = tqdm.write
+    delays = []
+
+    def report(events, pairs):
+        for ev in events:
+            delays.append(ev.delay)
+            label = ev.name or _class_name(ev.label, names)
+            write(
+                f"{ev.emitted_at / fps:8.2f} s  frame {ev.emitted_at:6d}  "
+                f"{label:<20}  frames {ev.start}-{ev.end - 1}  conf "
+                f"{ev.confidence:.2f}  delay {ev.delay} frames "
+                f"({ev.delay / fps:.2f} s)"
+            )
+        for decision, result in pairs:
+            if result is None:
+                write(f"{'':>25}robot: ignored ({decision.reason})")
+            elif result.accepted:
+                write(f"{'':>25}robot: {result.command} -> {result.state_after}")
+            else:
+                write(f"{'':>25}robot: {result.command} refused ({result.reason})")
+
+    start = time.perf_counter()
+    for t in bar:
+        if args.realtime:
+            lag = start + t / fps - time.perf_counter()
+            if lag > 0:
+                time.sleep(lag)
+        if commander is not None:
+            pairs = commander.push(stream[t])
+            report([d.event for d, _ in pairs], pairs)
+        else:
+            report(recognizer.push(stream[t]), [])
+    if commander is not None:
+        pairs = commander.flush()
+        report([d.event for d, _ in pairs], pairs)
+    else:
+        report(recognizer.flush(), [])
+    if hasattr(bar, "close"):
+        bar.close()
+    summary = f"{len(delays)} events"
+    if delays:
+        summary += (
+            f"; delay mean {np.mean(delays):.1f}, max {max(delays)} frames "
+            f"({max(delays) / fps:.2f} s)"
+        )
+    print(summary)
+    if robot is not None:
+        print(f"robot: {robot.status()}")
+    return 0
+
+
+def cmd_demo(args):
+    """Summarise PRECOG, train on subjects 1-6, report on subjects 7-8."""
+    from skgesture.datasets import load_precog
+
+    data = load_precog(verbose=_loader_verbose(args))
+    segments = np.concatenate(data.segments)
+    lengths = segments[:, 2] - segments[:, 1]
+    print("PRECOG 2016 (bundled, subjects 1-8, MIT licence, D. Jardim)")
+    print(
+        f"  sequences {len(data.X)}, frames {_n_frames(data):,}, subjects "
+        f"{len(np.unique(data.groups))}, gestures {len(segments)} (length "
+        f"{lengths.min()}-{lengths.max()}, median {np.median(lengths):.0f} frames)"
+    )
+    train = _select_subjects(data, DEMO_TRAIN_SUBJECTS, "PRECOG")
+    test = _select_subjects(data, DEMO_TEST_SUBJECTS, "PRECOG")
+    pipe = _make_model(args, 0 if args.quiet else 1)
+    _info(args, f"training method {args.method} on subjects {DEMO_TRAIN_SUBJECTS}")
+    start = time.perf_counter()
+    pipe.fit(train.X, train.y)
+    seconds = time.perf_counter() - start
+    y_pred = _predict(args, pipe, test.X)
+    scores = _scores(test, "precog", y_pred, _target_names(data))
+    _print_scores(
+        scores,
+        f"\nmethod {args.method}, trained in {seconds:.1f} s; held-out subjects "
+        f"{DEMO_TEST_SUBJECTS}:",
+    )
+    if args.output:
+        from skgesture._persistence import save_model
+
+        path = save_model(
+            pipe,
+            args.output,
+            metadata={"method": args.method, "data": "precog", "target_names": list(
+                map(str, data.target_names)
+            )},
+        )  # fmt: skip
+        print(f"model written to {path}")
+    return 0
