@@ -30,6 +30,7 @@ from skgesture.utils._validation import (
     check_stream_frames,
     missing_frames,
     refuse_set_output,
+    sequence_tags,
 )
 
 __all__ = ["JointFeatures"]
@@ -375,12 +376,7 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
         return np.asarray(names, dtype=object)
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        tags.input_tags.allow_nan = True
-        tags.requires_fit = True
-        return tags
+        return sequence_tags(super().__sklearn_tags__(), raw_skeletons=True)
 
     # -- incremental step (docs/design.md §4.1, "Incremental steps") -----------
     # StreamableMixin writes stream_init/step/flush; the state and the per-row
@@ -486,11 +482,10 @@ class JointFeatureStream:
         self.max_backfill = int(max_backfill)
         self.held_frames = HeldFrames(max_backfill)
         self.R = self.held_frames.frames  # filled raw frames, from p0
-        self.untracked = RowBuffer((), dtype=bool, capacity=32)
-        self.times = RowBuffer((), dtype=np.int64, capacity=32)
+        self.untracked = self.held_frames.untracked
+        self.times = self.held_frames.times
         self.Q = RowBuffer((7,), capacity=64)  # quantities of the tracked frames
         self.Q_frame = RowBuffer((), dtype=np.int64, capacity=64)  # their frames
-        self.n_in = 0
         self.n_out = 0
         self.p0 = None  # first frame with a filled raw frame
         self.f = None  # first tracked frame
@@ -501,17 +496,13 @@ class JointFeatureStream:
         """Raw frames in (checked as offline); the feature rows that became
         final out."""
         frames = check_stream_frames(rows.data, int(rows.time[0]), self.estimator)
-        times = rows.time
-        first = self.n_in
-        self.n_in += len(frames)
-        untracked = missing_frames(frames)
-        self.untracked.append(untracked)
-        self.times.append(times)
+        out, first, untracked = self.held_frames.push(
+            frames, rows.time, self.n_out, self._zeros
+        )
         tracked = ~untracked
         if tracked.any():
             self.Q.append(self.quantities(frames[tracked]))
             self.Q_frame.append(first + np.flatnonzero(tracked))
-        out = self.held_frames.push(frames, untracked, first, self.n_out, self._zeros)
         if self.held_frames.p0 is None:
             return _concat_rows(out, (self.width,), np.float32)
         self.p0, self.f = self.held_frames.p0, self.held_frames.first_tracked
@@ -521,13 +512,13 @@ class JointFeatureStream:
     def flush(self):
         """The remaining rows, the end rows with one-sided differences."""
         if self.p0 is None:
-            return self._zeros(self.n_in)
-        return self._emit(self.n_out, self.n_in, self.n_in - 1)
+            return self._zeros(self.held_frames.n_in)
+        return self._emit(self.n_out, self.held_frames.n_in, self.held_frames.n_in - 1)
 
     def _advance(self):
         """Rows final with the frames received: row ``t`` at frame
         ``max(t + a, first tracked frame, end of warm-up)``."""
-        now = self.n_in - 1
+        now = self.held_frames.n_in - 1
         start = max(self.f, self.ready)
         if now < start:
             return Rows.empty((self.width,), np.float32)

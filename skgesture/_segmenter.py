@@ -21,6 +21,7 @@ from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
     refuse_set_output,
+    sequence_tags,
     untracked_rows,
 )
 
@@ -392,10 +393,7 @@ class ActivitySegmenter(
         return remove_short_runs(active, self.min_length)
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        return tags
+        return sequence_tags(super().__sklearn_tags__())
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
     # The state (skgesture/_segmenter.py, SegmenterStream) uses the same

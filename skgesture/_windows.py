@@ -14,6 +14,7 @@ from skgesture.utils._validation import (
     SequenceOf,
     check_sequences,
     refuse_set_output,
+    sequence_tags,
     untracked_rows,
 )
 
@@ -500,10 +501,7 @@ class DynamicPoseWindow(
         return refuse_set_output(self, transform)
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        return tags
+        return sequence_tags(super().__sklearn_tags__())
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
 

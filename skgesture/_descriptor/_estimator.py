@@ -51,6 +51,7 @@ from skgesture.utils._validation import (
     check_skeletons,
     missing_frames,
     refuse_set_output,
+    sequence_tags,
 )
 
 __all__ = ["PoseDescriptor"]
@@ -489,12 +490,7 @@ class PoseDescriptor(
         return out
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        tags.input_tags.allow_nan = True
-        tags.requires_fit = True
-        return tags
+        return sequence_tags(super().__sklearn_tags__(), raw_skeletons=True)
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
     # StreamableMixin writes stream_init/step/flush; the state is

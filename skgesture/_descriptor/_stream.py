@@ -11,8 +11,8 @@ stream are those of offline ``transform``, from one implementation.
 import numpy as np
 
 from skgesture._stream import DEFAULT_MAX_BACKFILL, Rows
-from skgesture.utils._buffers import HeldFrames, RowBuffer, _concat_rows
-from skgesture.utils._validation import check_stream_frames, missing_frames
+from skgesture.utils._buffers import HeldFrames, _concat_rows
+from skgesture.utils._validation import check_stream_frames
 
 _WARM = []  # whether the descriptor's code was run once in this process
 
@@ -52,13 +52,12 @@ class DescriptorStream:
         self.max_backfill = int(max_backfill)
         self.held_frames = HeldFrames(max_backfill)
         self.R = self.held_frames.frames  # filled raw frames
-        self.untracked = RowBuffer((), dtype=bool, capacity=32)
-        self.times = RowBuffer((), dtype=np.int64, capacity=32)
+        self.untracked = self.held_frames.untracked
+        self.times = self.held_frames.times
         if not _WARM:  # load the compiled kernel now, not on the first frame
             still = np.random.RandomState(0).normal(size=(2 * self.a + 1, 20, 3))
             describe(still)
             _WARM.append(True)
-        self.n_in = 0
         self.n_out = 0
         self.p0 = None  # first frame held (None: no tracked frame yet)
         self.f = None  # first tracked frame
@@ -67,14 +66,8 @@ class DescriptorStream:
         """Raw frames in (checked as offline); the descriptor rows that became
         final out."""
         frames = check_stream_frames(rows.data, int(rows.time[0]), self.estimator)
-        times = rows.time
-        first = self.n_in
-        self.n_in += len(frames)
-        untracked = missing_frames(frames)
-        self.untracked.append(untracked)
-        self.times.append(times)
-        out = self.held_frames.push(
-            frames, untracked, first, self.n_out, self._hand_on_leading
+        out, _, _ = self.held_frames.push(
+            frames, rows.time, self.n_out, self._hand_on_leading
         )
         if self.held_frames.p0 is None:
             self._trim()
@@ -89,7 +82,7 @@ class DescriptorStream:
     def flush(self):
         """The last rows, with the offline end padding."""
         if self.p0 is None:
-            return self._hand_on_leading(self.n_in)
+            return self._hand_on_leading(self.held_frames.n_in)
         return self._advance(final=True)
 
     def _advance(self, final):
@@ -136,7 +129,7 @@ class DescriptorStream:
         if self.p0 is not None:
             self.R.drop(self.n_out - self.a)
         self.untracked.drop(self.n_out)
-        self.times.drop(min(self.n_out, self.n_in - 1))
+        self.times.drop(min(self.n_out, self.held_frames.n_in - 1))
 
     def held(self):
         """Rows held by the buffers."""

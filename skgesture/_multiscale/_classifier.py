@@ -43,6 +43,7 @@ from skgesture.utils._validation import (
     SequenceOf,
     check_sequence_labels,
     check_sequences,
+    sequence_tags,
     untracked_rows,
 )
 
@@ -484,10 +485,7 @@ class MultiScaleClassifier(StreamableMixin, ClassifierMixin, BaseEstimator):
         return [(lab, np.array(segs, dtype=float).reshape(-1, 4)) for lab, segs in out]
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
-        return tags
+        return sequence_tags(super().__sklearn_tags__())
 
     # -- incremental step (docs/design.md, "Incremental steps") ----------------
     # The state (skgesture/_multiscale/_stream.py, MultiScaleStream) tracks periods,

@@ -26,6 +26,7 @@ from sklearn.utils.validation import check_is_fitted
 from skgesture._nn._training import (
     IGNORE_INDEX,
     fit_cached,
+    seed_from,
     torch_threads,
 )
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
@@ -34,6 +35,7 @@ from skgesture._taggers._stream import TrailingWindowStream
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
+    sequence_tags,
     untracked_rows,
 )
 
@@ -223,9 +225,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         )
 
     def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.two_d_array = False
-        tags.input_tags.three_d_array = True
+        tags = sequence_tags(super().__sklearn_tags__())
         tags.non_deterministic = getattr(self, "device", "cpu") != "cpu"
         return tags
 
@@ -292,6 +292,24 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         name = f"{type(self).__name__}.smooth_span"
         h = make_smoother(self.smoothing, self.smooth_span, 1, owner=name).h
         return int(future) + h + int(self.max_gap) + 1
+
+    def _training_params(self):
+        """The parameters of the training loop every tagger's network takes
+        (``FramewiseNetwork``), from the tagger's own; the network's seed is
+        drawn from ``random_state``."""
+        seed = None if self.random_state is None else seed_from(self.random_state)
+        return {
+            "max_epochs": self.max_epochs,
+            "batch_size": self.batch_size,
+            "learning_rate": self.learning_rate,
+            "weight_decay": self.weight_decay,
+            "early_stopping": self.early_stopping,
+            "validation_fraction": self.validation_fraction,
+            "n_iter_no_change": self.n_iter_no_change,
+            "device": self.device,
+            "random_state": seed,
+            "verbose": self.verbose,
+        }
 
     def _stream_scorer(self, past):
         """Probabilities of a frame in a stream: ``_raw_proba`` on a window."""

@@ -593,22 +593,11 @@ class BiLSTMTagger(_BaseTagger):
             window=self.window,
             rest_step=self.rest_step,
             gesture_step=self.gesture_step,
-            max_epochs=self.max_epochs,
-            batch_size=self.batch_size,
-            learning_rate=self.learning_rate,
             momentum=self.momentum,
-            weight_decay=self.weight_decay,
             lr_drop_factor=self.lr_drop_factor,
             lr_drop_period=self.lr_drop_period,
             time_reduction=self.time_reduction,
-            early_stopping=self.early_stopping,
-            validation_fraction=self.validation_fraction,
-            n_iter_no_change=self.n_iter_no_change,
-            device=self.device,
-            random_state=(
-                None if self.random_state is None else seed_from(self.random_state)
-            ),
-            verbose=self.verbose,
+            **self._training_params(),
         )
 
     def _adopt(self, fitted):

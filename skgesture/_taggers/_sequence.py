@@ -17,7 +17,6 @@ from skgesture._nn._modules import (
     TemporalConvModule,
 )
 from skgesture._nn._sequence_net import _CropNet, predict_whole
-from skgesture._nn._training import seed_from
 from skgesture._taggers._base import (
     _DECODING_CONSTRAINTS,
     _STREAM_CONSTRAINTS,
@@ -315,23 +314,12 @@ class SequenceTagger(_BaseTagger):
             tcn_stages=self.tcn_stages,
             smoothing_weight=self.smoothing_weight,
             crop_length=self.crop_length,
-            batch_size=self.batch_size,
             steps_per_epoch=self.steps_per_epoch,
-            max_epochs=self.max_epochs,
-            learning_rate=self.learning_rate,
-            weight_decay=self.weight_decay,
             clip_norm=self.clip_norm,
             class_weight=self._class_weight,
             augmenter=None if self.augment is None else clone(self.augment),
             standardize=self.standardize,
-            early_stopping=self.early_stopping,
-            validation_fraction=self.validation_fraction,
-            n_iter_no_change=self.n_iter_no_change,
-            device=self.device,
-            random_state=(
-                None if self.random_state is None else seed_from(self.random_state)
-            ),
-            verbose=self.verbose,
+            **self._training_params(),
         )
 
     def _adopt(self, fitted):

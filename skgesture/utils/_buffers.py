@@ -5,6 +5,7 @@
 import numpy as np
 
 from skgesture._stream import Rows
+from skgesture.utils._validation import missing_frames
 
 
 class RowBuffer:
@@ -132,6 +133,12 @@ class HeldFrames:
     ----------
     frames : RowBuffer
         The filled raw frames, from ``p0`` on.
+    untracked : RowBuffer
+        Whether each frame pushed was untracked (all zeros or a NaN).
+    times : RowBuffer
+        The stream time of each frame pushed.
+    n_in : int
+        Frames pushed.
     p0 : int or None
         First frame held (``None`` until a tracked frame arrives).
     first_tracked : int or None
@@ -144,30 +151,40 @@ class HeldFrames:
     >>> held = HeldFrames(max_backfill=1, frame_shape=(1,))
     >>> x = np.array([[0.0], [0.0], [2.0], [0.0], [3.0]])
     >>> handed = []
-    >>> out = held.push(x, x[:, 0] == 0, 0, 0, lambda until: handed.append(until))
-    >>> handed, held.p0, held.frames.data(1, 5)[:, 0].tolist()
-    ([1], 1, [2.0, 2.0, 2.0, 3.0])
+    >>> out, first, untracked = held.push(x, np.arange(5), 0, handed.append)
+    >>> handed, held.p0, held.frames.data(1, 5)[:, 0].tolist(), untracked.tolist()
+    ([1], 1, [2.0, 2.0, 2.0, 3.0], [True, True, False, True, False])
     """
 
     def __init__(self, max_backfill, frame_shape=(20, 3)):
         self.max_backfill = int(max_backfill)
         self.frames = RowBuffer(frame_shape, capacity=32)
+        self.untracked = RowBuffer((), dtype=bool, capacity=32)
+        self.times = RowBuffer((), dtype=np.int64, capacity=32)
+        self.n_in = 0
         self.p0 = None
         self.first_tracked = None
         self.last = None  # the last tracked (or held) frame
 
-    def push(self, frames, untracked, first, n_out, hand_on):
-        """Append the next frames (``frames[0]`` is stream frame ``first``).
+    def push(self, frames, times, n_out, hand_on):
+        """Append the next validated frames, whose stream times are ``times``.
 
         ``n_out`` is the stage's count of rows handed on; ``hand_on(until)``
         hands on the leading frames before ``until`` as rest and returns its
-        output. Returns the list of those outputs (empty once tracking began).
+        output. Returns the list of those outputs (empty once tracking began),
+        the index of ``frames[0]`` and the frames' untracked mask.
         """
+        first = self.n_in
+        self.n_in += len(frames)
+        untracked = missing_frames(frames)
+        self.untracked.append(untracked)
+        self.times.append(times)
+        mask = untracked
         out = []
         if self.p0 is None:
             if untracked.all():
                 out.append(hand_on(first + len(frames) - self.max_backfill))
-                return out
+                return out, first, mask
             k = int(np.argmax(~untracked))
             until = first + k - self.max_backfill
             out.append(hand_on(until))
@@ -187,7 +204,7 @@ class HeldFrames:
             frames[src >= 0] = frames[src[src >= 0]]
         self.last = frames[-1]
         self.frames.append(frames)
-        return out
+        return out, first, mask
 
 
 def _concat_rows(parts, row_shape, dtype=np.float64):

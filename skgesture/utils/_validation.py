@@ -552,3 +552,29 @@ def check_stream_frames(frames, first, estimator):
     return check_skeletons(
         [frames], estimator=estimator, reset=False, first_frame=int(first)
     )[0]
+
+
+def sequence_tags(tags, *, raw_skeletons=False):
+    """scikit-learn tags of a stage whose input is a list of sequences.
+
+    Not 2-D arrays but 3-D-like sequences; a stage reading raw skeletons also
+    allows NaN (untracked joints) and needs fitting.
+
+    Parameters
+    ----------
+    tags : sklearn.utils.Tags
+        The tags of the base classes (``super().__sklearn_tags__()``).
+    raw_skeletons : bool, default=False
+        Whether the stage reads raw skeletons ``(n_frames, 20, 3)``.
+
+    Returns
+    -------
+    sklearn.utils.Tags
+        ``tags``, updated.
+    """
+    tags.input_tags.two_d_array = False
+    tags.input_tags.three_d_array = True
+    if raw_skeletons:
+        tags.input_tags.allow_nan = True
+        tags.requires_fit = True
+    return tags
