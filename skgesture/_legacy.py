@@ -6,7 +6,14 @@ private module that defined them then (``skgesture._tagger.SequenceTagger``,
 ``skgesture._nn`` and ``skgesture._taggers`` subpackages (docs/design.md,
 "Module map"). This module keeps the old paths importable: an old path is a
 module whose attributes are looked up, in order, in the modules its names went
-to. New files record the new paths (the public names where a class has one).
+to.
+
+Model files written now name the classes of the public API by their public
+names (``skgesture.PoseDescriptor``), which no move changes; the classes they
+name by a private path (network modules, losses and loaders in the manifest,
+the placeholders of ``skgesture._persistence``, and every class in a joblib
+pickle) keep working across a later move only if the old module path is added
+to :data:`MOVED` (docs/persistence.md, "Names in a file").
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -75,8 +82,21 @@ class _Finder(importlib.abc.MetaPathFinder):
 
 
 def old_paths(cls):
-    """The 0.1 module paths under which ``cls`` was reachable."""
-    return [old for old, new in MOVED.items() if cls.__module__ in new]
+    """The old module paths (keys of :data:`MOVED`) that resolve ``cls``.
+
+    An old path resolves a name to the first of its modules that defines it,
+    so a class is listed only where that lookup gives the class itself.
+    """
+    paths = []
+    for old, new in MOVED.items():
+        if cls.__module__ not in new:
+            continue
+        try:
+            if _lookup(old, cls.__name__) is cls:
+                paths.append(old)
+        except AttributeError:
+            pass
+    return paths
 
 
 def install():

@@ -6,20 +6,30 @@ A model file is one zip archive with exactly three members:
   the model expects (frame shape, skeleton layout, descriptor joints), how to
   rebuild each network, checksums of the other members, and user metadata;
 * ``estimator.skops``: the estimator written by ``skops.io.dumps``, in which
-  every skorch network is replaced by a placeholder;
+  every skorch network is replaced by a placeholder and every class of the
+  public API is named by its public name (``skgesture.PoseDescriptor``), so
+  that moving a private module never breaks a file;
 * ``weights.safetensors``: the tensors of every network (module and criterion
   state dicts, tensors among the net's parameters), always stored on the CPU.
 
 Loading never unpickles anything: skops rebuilds the estimator from its schema
-(refusing types nobody trusted), safetensors reads raw tensors, and a network is
-rebuilt from its module class (which must belong to skgesture) and its JSON
-keyword arguments, then given its weights. See ``docs/persistence.md``.
+(refusing types nobody trusted; skgesture's trusted types are derived from the
+public API table, ``skgesture._LAZY``), safetensors reads raw tensors, and a
+network is rebuilt from its module class (which must belong to skgesture) and
+its JSON keyword arguments, then given its weights. See ``docs/persistence.md``.
+
+Longer than 1,000 lines because it is the one writer and reader of the file
+format, and a security boundary: what a file may name, how it is written and
+how each part is checked on reading are kept side by side, so that a change to
+one is read against the others.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import functools
 import hashlib
 import importlib
+import io
 import json
 import os
 import re
@@ -32,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from skgesture._legacy import MOVED
+from skgesture._legacy import old_paths
 from skgesture._version import __version__
 
 __all__ = [
@@ -72,26 +82,13 @@ _SKORCH_ATTRIBUTES = {
 }
 # Net parameters that only matter in training and are never stored.
 _TRAINING_ONLY = {"callbacks", "train_split"}
-# skgesture modules whose estimator classes are trusted by load_model.
-_TRUSTED_MODULES = (
-    "skgesture._augment",
-    "skgesture._descriptor",
-    "skgesture._descriptor._estimator",
-    "skgesture._features",
-    "skgesture._multiscale",
-    "skgesture._multiscale._classifier",
-    "skgesture._nn._mlp",
-    "skgesture._nn._modules",
-    "skgesture._nn._sequence_net",
-    "skgesture._nn._training",
-    "skgesture._segmenter",
-    "skgesture._taggers._bilstm",
-    "skgesture._taggers._sequence",
-    "skgesture._taggers._voting",
-    "skgesture._windows",
-    "skgesture.layouts",
-    "skgesture._persistence",
-    *MOVED,  # files written by 0.1
+# Classes that skgesture's estimators hold which are not in the public API
+# table, by the public module that exports them (with the estimators of the
+# table and the placeholders below, the only classes of skgesture that
+# load_model trusts).
+_SUPPORT_CLASSES = (
+    ("skgesture.layouts", "DescriptorJoints"),
+    ("skgesture.layouts", "SkeletonLayout"),
 )
 
 
@@ -574,10 +571,13 @@ def save_model(estimator, path, *, metadata=None, overwrite=True):
 
     Notes
     -----
-    Network parameters that only matter in training (callbacks, the
-    validation split, components whose arguments are not JSON values) are not
-    stored: a loaded network predicts exactly as the saved one, and
-    ``fit`` of the loaded estimator builds new networks as usual. Weights are
+    Classes of skgesture's public API are recorded under their public
+    names (``skgesture.PoseDescriptor``), so moving a private module never
+    breaks a file. Network parameters that only matter in training
+    (callbacks, the validation split, components whose arguments are not
+    JSON values) are not stored: a loaded network predicts exactly as the
+    saved one, and ``fit`` of the loaded estimator builds new networks as
+    usual. Weights are
     always stored on the CPU; a network trained with ``device="cuda"`` loads
     on a machine without CUDA.
 
@@ -628,6 +628,7 @@ def save_model(estimator, path, *, metadata=None, overwrite=True):
         skops_bytes = sio.dumps(stripped, compression=zipfile.ZIP_DEFLATED)
     except Exception as exc:  # skops raises many types for unsupported objects
         raise ValueError(f"cannot write the estimator with skops: {exc}") from exc
+    skops_bytes = _with_public_names(skops_bytes)
     weights_bytes = safetensors.torch.save(blobs)
     import sklearn
     import skops
@@ -642,7 +643,7 @@ def save_model(estimator, path, *, metadata=None, overwrite=True):
             "skops": skops.__version__,
             "torch": torch.__version__,
         },
-        "estimator": _class_path(type(estimator)),
+        "estimator": _public_class_path(type(estimator)),
         "input": _input_layout(estimator),
         "classes": _classes(estimator),
         "nets": specs,
@@ -770,25 +771,121 @@ def _check_layout(path, manifest, layout):
         )
 
 
-def _trusted_by_skgesture(type_name):
-    """Whether ``type_name`` is a class of skgesture that a model file may hold."""
-    module_name, _, name = type_name.rpartition(".")
-    if module_name not in _TRUSTED_MODULES:
-        return False
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError:
-        return False
-    obj = getattr(module, name, None)
-    if obj in (_NetSlot, _TensorSlot):
-        return True
+# -- the classes of skgesture a model file names ------------------------------------
+
+
+@functools.cache
+def _skgesture_classes():
+    """``{class: stable name}`` of every class of skgesture a model file may hold.
+
+    The estimators of the public API table (``skgesture._LAZY``: the public
+    classes that are scikit-learn estimators) under their public names
+    (``skgesture.PoseDescriptor``), the classes they hold that the table does
+    not list (:data:`_SUPPORT_CLASSES`) under their public module, and the
+    placeholders of this module under their own path.
+    """
     from sklearn.base import BaseEstimator
 
-    from skgesture.layouts import DescriptorJoints, SkeletonLayout
+    import skgesture
 
-    return isinstance(obj, type) and (
-        issubclass(obj, BaseEstimator) or obj in (DescriptorJoints, SkeletonLayout)
-    )
+    classes = {}
+    for name in skgesture._LAZY:
+        obj = getattr(skgesture, name)
+        if isinstance(obj, type) and issubclass(obj, BaseEstimator):
+            classes[obj] = f"skgesture.{name}"
+    for module, name in _SUPPORT_CLASSES:
+        classes[getattr(importlib.import_module(module), name)] = f"{module}.{name}"
+    for cls in (_NetSlot, _TensorSlot):
+        classes[cls] = f"{cls.__module__}.{cls.__qualname__}"
+    return classes
+
+
+def _resolve(type_name):
+    """The object at the dotted path ``type_name``, found as skops finds it."""
+    module_name, _, name = type_name.rpartition(".")
+    try:
+        return getattr(importlib.import_module(module_name), name)
+    except (ImportError, AttributeError):
+        return None
+
+
+@functools.cache
+def _trusted_type_names():
+    """Every type name under which ``load_model`` trusts a class of skgesture.
+
+    For each class of :func:`_skgesture_classes`: its stable name (files of
+    this version), the module that defines it and the packages above that
+    module that export it (files written before public names were recorded;
+    0.1's ``skgesture._descriptor`` was a module), the module the API table
+    names for it, and its module paths of 0.1 (``skgesture._legacy.MOVED``).
+    A name is trusted only if it imports that very class, so nothing outside
+    the table is reachable through one.
+    """
+    import skgesture
+
+    names = set()
+    for cls, stable in _skgesture_classes().items():
+        name, module = cls.__name__, cls.__module__
+        parts = module.split(".")
+        candidates = {stable, f"{module}.{name}"}
+        candidates |= {".".join(parts[:i]) + f".{name}" for i in range(2, len(parts))}
+        if name in skgesture._LAZY:
+            candidates.add(f"{skgesture._LAZY[name]}.{name}")
+        candidates |= {f"{old}.{name}" for old in old_paths(cls)}
+        names |= {c for c in candidates if _resolve(c) is cls}
+    return frozenset(names)
+
+
+def _renamed_modules():
+    """``{"module.Class": public module}`` for the classes that have a public
+    name other than the path that defines them."""
+    renames = {}
+    for cls, stable in _skgesture_classes().items():
+        module, _, name = stable.rpartition(".")
+        here = f"{cls.__module__}.{cls.__name__}"
+        if name == cls.__name__ and stable != here:
+            renames[here] = module
+    return renames
+
+
+def _with_public_names(skops_bytes):
+    """The skops archive ``skops_bytes`` with its classes named by public names.
+
+    Every node of the schema whose ``__module__`` and ``__class__`` name a
+    class of :func:`_renamed_modules` gets the public module (``skgesture``
+    for ``skgesture._descriptor._estimator.PoseDescriptor``); skops imports
+    the class from there when loading (``skgesture`` resolves it lazily).
+    """
+    renames = _renamed_modules()
+    with zipfile.ZipFile(io.BytesIO(skops_bytes)) as zf:
+        members = [(info, zf.read(info)) for info in zf.infolist()]
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as out:
+        for info, blob in members:
+            if info.filename == "schema.json":
+                schema = json.loads(blob)
+                stack = [schema]
+                while stack:
+                    node = stack.pop()
+                    if isinstance(node, list):
+                        stack.extend(node)
+                    elif isinstance(node, dict):
+                        module, name = node.get("__module__"), node.get("__class__")
+                        if isinstance(module, str) and isinstance(name, str):
+                            node["__module__"] = renames.get(f"{module}.{name}", module)
+                        stack.extend(node.values())
+                blob = json.dumps(schema, indent=2).encode()
+            out.writestr(info.filename, blob, compress_type=info.compress_type)
+    return buffer.getvalue()
+
+
+def _public_class_path(cls):
+    """``module:qualname`` of ``cls``, by its public name where it has one."""
+    stable = _skgesture_classes().get(cls)
+    if stable is not None and f"{cls.__module__}.{cls.__name__}" in _renamed_modules():
+        module, _, name = stable.rpartition(".")
+        return f"{module}:{name}"
+    return _class_path(cls)
 
 
 def model_info(path):
@@ -853,8 +950,12 @@ def load_model(path, *, trusted=None, layout=None, allow_version_mismatch=False)
     trusted : list of str or None, default=None
         Further types to trust, as listed by the error (or by
         ``skops.io.get_untrusted_types``). Types that skops trusts by
-        default (scikit-learn, numpy, scipy) and skgesture's own estimators are
-        always trusted; anything else in the file is refused unless named here.
+        default (scikit-learn, numpy, scipy), the estimators of skgesture's
+        public API (the classes of ``skgesture.__all__``, under their public
+        name, their module path or their 0.1 path) and the few classes they
+        hold (``skgesture.layouts.DescriptorJoints`` and ``SkeletonLayout``)
+        are always trusted; anything else in the file is refused unless named
+        here.
     layout : str, tuple of int or None, default=None
         The skeleton layout name (e.g. ``"kinect_v1"``) or frame shape (e.g.
         ``(20, 3)``) of the data the model will be used on; a model trained on
@@ -921,7 +1022,7 @@ def load_model(path, *, trusted=None, layout=None, allow_version_mismatch=False)
         raise ModelFileError(f"{path}: unreadable estimator ({exc})") from None
     user_trusted = set(trusted or ())
     refused = [
-        t for t in found if t not in user_trusted and not _trusted_by_skgesture(t)
+        t for t in found if t not in user_trusted and t not in _trusted_type_names()
     ]
     if refused:
         raise UntrustedTypesError(

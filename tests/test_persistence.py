@@ -2,8 +2,10 @@
 
 import copy
 import hashlib
+import io
 import json
 import pickle
+import sys
 import zipfile
 
 import joblib
@@ -30,6 +32,8 @@ from skgesture._persistence import (  # noqa: E402
     ModelFileError,
     ModelVersionError,
     UntrustedTypesError,
+    _find_torch_objects,
+    _trusted_type_names,
     model_info,
 )
 from skgesture.datasets import make_gesture_streams  # noqa: E402
@@ -227,6 +231,95 @@ def test_joblib_keeps_working_for_trusted_use(fitted, data, tmp_path):
         _assert_same_predictions(fitted[method], joblib.load(path), data.X)
 
 
+def _nets(estimator):
+    return [net for net, _ in _find_torch_objects(estimator)[0]]
+
+
+def _weight_bytes(estimator):
+    """Bytes of every network's weights (its module's state dict)."""
+    return sum(
+        t.nbytes for net in _nets(estimator) for t in net.module_.state_dict().values()
+    )
+
+
+def _holds_training_state(callback):
+    """Whether a callback holds tensors (best weights) or an optimizer (a
+    learning-rate scheduler's)."""
+
+    def heavy(v):
+        if isinstance(v, (torch.Tensor, torch.optim.Optimizer)):
+            return True
+        if isinstance(v, dict):
+            return any(isinstance(t, torch.Tensor) for t in v.values())
+        return isinstance(getattr(v, "optimizer", None), torch.optim.Optimizer)
+
+    return any(heavy(v) for v in vars(callback).values())
+
+
+@pytest.mark.parametrize("method", ["B", "C"])
+def test_pickle_leaves_training_state_out(method, data, tmp_path):
+    # Networks of 16 units, so that the weights outweigh the rest of the
+    # pipeline; SCG (Method B) keeps 6 times their size as optimizer state,
+    # and the stopping callbacks a copy of the best weights.
+    if method == "B":
+        net = {"hidden_layer_sizes": (16,), "activations": ("tanh",), "max_epochs": 10}
+        model = make_method_b(random_state=0).set_params(
+            segmenter__estimator=TorchMLPClassifier(**net),
+            classifier__estimator=TorchMLPClassifier(**net),
+        )
+    else:
+        model = make_method_c(random_state=0).set_params(
+            tagger__hidden_sizes=(16,), tagger__max_epochs=2
+        )
+    with torch.random.fork_rng(devices=[]):
+        model.fit(data.X, data.y)
+    nets = _nets(model)
+    # training state: the optimizer's, and tensors held by the callbacks
+    assert nets and all(net.optimizer_.state for net in nets)
+    assert all(
+        any(_holds_training_state(cb) for _, cb in net.callbacks_) for net in nets
+    )
+    weights = _weight_bytes(model)
+    blob = pickle.dumps(model)
+    joblib.dump(model, tmp_path / "model.joblib")
+    assert len(blob) <= 2 * weights
+    assert (tmp_path / "model.joblib").stat().st_size <= 2 * weights
+    assert all(net.optimizer_.state for net in nets)  # the model keeps it
+    loaded = pickle.loads(blob)
+    _assert_same_predictions(model, loaded, data.X)
+    if method == "C":
+        for a, b in zip(model.predict_proba(data.X), loaded.predict_proba(data.X)):
+            assert_array_equal(a, b)
+    for net in _nets(loaded):
+        assert not net.optimizer_.state
+        # the optimizer drives the module's own parameters, not copies of them
+        driven = {id(p) for g in net.optimizer_.param_groups for p in g["params"]}
+        assert driven == {id(p) for p in net.module_.parameters()}
+        assert not any(_holds_training_state(cb) for _, cb in net.callbacks_)
+        assert len(net.history) > 0
+    # the copy is fitted again as the original was
+    with torch.random.fork_rng(devices=[]):
+        loaded.fit(data.X, data.y)
+    _assert_same_predictions(model, loaded, data.X)
+
+
+def test_unpickled_network_can_continue_training():
+    # warm start: the weights are kept, the optimizer starts afresh
+    rng = np.random.RandomState(0)
+    X = rng.normal(size=(60, 3))
+    y = (X[:, 0] > 0).astype(int)
+    clf = _tiny_mlp().set_params(random_state=0)
+    with torch.random.fork_rng(devices=[]):
+        clf.fit(X, y)
+    copy_ = pickle.loads(pickle.dumps(clf))
+    before = [p.detach().clone() for p in copy_.net_.module_.parameters()]
+    with torch.random.fork_rng(devices=[]):
+        copy_.net_.partial_fit(X.astype(np.float32), y.astype(np.float32)[:, None])
+    assert len(copy_.net_.history) > len(clf.net_.history)
+    after = list(copy_.net_.module_.parameters())
+    assert any(not torch.equal(a, b) for a, b in zip(before, after))
+
+
 def test_model_info_records_version_layout_and_metadata(fitted, tmp_path):
     path = save_model(
         fitted["B"], tmp_path / "b.skg", metadata={"target_names": ["a", "b", "c"]}
@@ -294,29 +387,131 @@ def test_pickle_in_place_of_the_weights_is_refused(saved_b, tmp_path):
     assert not marker.exists()
 
 
-def test_untrusted_type_in_the_schema_is_refused(saved_b, tmp_path):
-    # An attacker rewrites the skops schema to build os.system instead of a
-    # PoseDescriptor (and fixes the checksums): refused before anything is built.
-    with zipfile.ZipFile(saved_b) as zf:
-        inner = zf.read("estimator.skops")
-    src = tmp_path / "inner.skops"
-    src.write_bytes(inner)
+def _edit_schema(src, dst, edit):
+    """Copy a model file, passing the skops schema (a dict) through ``edit``."""
     with zipfile.ZipFile(src) as zf:
+        inner = zf.read("estimator.skops")
+    with zipfile.ZipFile(io.BytesIO(inner)) as zf:
         files = {n: zf.read(n) for n in zf.namelist()}
-    schema = files["schema.json"].decode()
-    assert '"skgesture._descriptor._estimator"' in schema
-    schema = schema.replace('"skgesture._descriptor._estimator"', '"os"').replace(
-        '"PoseDescriptor"', '"system"'
-    )
-    files["schema.json"] = schema.encode()
-    dst = tmp_path / "inner2.skops"
-    with zipfile.ZipFile(dst, "w") as zf:
+    schema = json.loads(files["schema.json"])
+    edit(schema)
+    files["schema.json"] = json.dumps(schema).encode()
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as zf:
         for name, blob in files.items():
             zf.writestr(name, blob)
-    bad = _rewrite(saved_b, tmp_path / "bad.skg", estimator__skops=dst.read_bytes())
-    with pytest.raises(UntrustedTypesError, match="os.system") as err:
+    return _rewrite(src, dst, estimator__skops=buffer.getvalue())
+
+
+def _nodes(schema):
+    """Every node of a skops schema that names a class."""
+    stack = [schema]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, list):
+            stack.extend(node)
+        elif isinstance(node, dict):
+            if isinstance(node.get("__module__"), str):
+                yield node
+            stack.extend(node.values())
+
+
+def _renamer(old_class, module, name):
+    def edit(schema):
+        found = [n for n in _nodes(schema) if n["__class__"] == old_class]
+        assert found, f"no {old_class} in the schema"
+        for node in found:
+            node["__module__"], node["__class__"] = module, name
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    "module, name",
+    [
+        ("os", "system"),
+        # skgesture classes outside the public API table: a private estimator,
+        # a public class that is no estimator, a module reached through an
+        # old 0.1 path, a private base class reached through one
+        ("skgesture._nn._training", "FramewiseNetwork"),
+        ("skgesture", "StreamingRecognizer"),
+        ("skgesture._networks", "copy"),
+        ("skgesture._tagger", "_BaseTagger"),
+    ],
+)
+def test_untrusted_type_in_the_schema_is_refused(saved_b, tmp_path, module, name):
+    # An attacker rewrites the skops schema to build another type instead of a
+    # PoseDescriptor (and fixes the checksums): refused before anything is built.
+    bad = _edit_schema(
+        saved_b, tmp_path / "bad.skg", _renamer("PoseDescriptor", module, name)
+    )
+    with pytest.raises(UntrustedTypesError, match=f"{module}.{name}") as err:
         load_model(bad)
-    assert err.value.types == ["os.system"]
+    assert err.value.types == [f"{module}.{name}"]
+
+
+def test_trusted_types_are_the_public_api_and_what_it_holds():
+    from sklearn.base import BaseEstimator
+
+    from skgesture import layouts
+    from skgesture._legacy import MOVED
+    from skgesture._persistence import _NetSlot, _TensorSlot
+
+    public = {
+        getattr(skgesture, n)
+        for n in skgesture._LAZY
+        if isinstance(getattr(skgesture, n), type)
+        and issubclass(getattr(skgesture, n), BaseEstimator)
+    }
+    assert {TorchMLPClassifier, skgesture.PoseDescriptor} <= public
+    support = {layouts.DescriptorJoints, layouts.SkeletonLayout, _NetSlot, _TensorSlot}
+    names = _trusted_type_names()
+    resolved = {}
+    for name in names:
+        module, _, attr = name.rpartition(".")
+        __import__(module)
+        resolved[name] = getattr(sys.modules[module], attr)
+    # every trusted name imports a class of the table or one it holds, and
+    # every class of the table is trusted under its public name
+    assert set(resolved.values()) == public | support
+    for cls in public:
+        assert f"skgesture.{cls.__name__}" in names
+        assert f"{cls.__module__}.{cls.__name__}" in names
+    # the paths of 0.1 stay trusted for old files: the moved modules that held
+    # estimators, and the modules that became packages
+    assert {n.rpartition(".")[0] for n in names if n.rpartition(".")[0] in MOVED} == {
+        "skgesture._tagger",
+        "skgesture._bilstm",
+        "skgesture._mlp",
+    }
+    assert {
+        "skgesture._descriptor.PoseDescriptor",
+        "skgesture._tagger.VotingTagger",
+    } < (names)
+    # nothing else of skgesture is
+    assert "skgesture._nn._training.FramewiseNetwork" not in names
+    assert "skgesture.streaming.StreamingRecognizer" not in names
+
+
+def test_a_file_outlives_the_module_that_defined_its_classes(
+    saved_b, fitted, data, tmp_path, monkeypatch
+):
+    # As after a move: the module that defines PoseDescriptor can no longer be
+    # imported. The file names skgesture.PoseDescriptor, and loads.
+    _trusted_type_names()  # cached as in any session, before the module goes
+    monkeypatch.setitem(sys.modules, "skgesture._descriptor._estimator", None)
+    loaded = load_model(saved_b)
+    _assert_same_predictions(fitted["B"], loaded, data.X)
+    # a file naming the private path (as files did before) breaks on the move
+    private = _edit_schema(
+        saved_b,
+        tmp_path / "private.skg",
+        _renamer(
+            "PoseDescriptor", "skgesture._descriptor._estimator", "PoseDescriptor"
+        ),
+    )
+    with pytest.raises(ModelFileError):
+        load_model(private)
 
 
 class _Doubler(TransformerMixin, BaseEstimator):

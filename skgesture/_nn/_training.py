@@ -7,13 +7,15 @@ own networks fit them through :func:`fit_cached`, which caches the fitted networ
 with ``joblib.Memory`` keyed on the training data and the network's own
 parameters only, so decision parameters (thresholds, weights, smoothing,
 minimum lengths) can be searched by ``GridSearchCV`` without retraining
-(docs/design.md §3).
+(docs/design.md §3). Every network is a :class:`LeanNet`, which leaves its
+training-only state out of pickles.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
 import copy
 import threading
+from collections import defaultdict
 from contextlib import contextmanager
 
 import numpy as np
@@ -32,6 +34,7 @@ from skgesture._nn._modules import MLPModule
 __all__ = [
     "FramewiseLoss",
     "FramewiseNetwork",
+    "LeanNet",
     "MLPModule",
     "build_net",
     "fit_cached",
@@ -50,6 +53,64 @@ TEST_FRACTION = 0.15
 PREDICT_BATCH = 65536
 IGNORE_INDEX = -100  # target of frames a framewise loss leaves out (padding, untracked)
 SMOOTHING_CLAMP = 16.0  # MS-TCN's truncation of the squared log-prob change
+
+
+class LeanNet(NeuralNet):
+    """skorch's ``NeuralNet``, pickled without its training-only state.
+
+    Every network of skgesture is one. A fitted net holds, besides its
+    weights, state that only training uses: the optimiser's (SCG keeps three
+    float64 vectors of the size of the weights, Adam two moments) and its
+    callbacks' (the best weights so far, the learning-rate scheduler and its
+    optimiser, a progress bar). A pickle (``pickle``, ``joblib``,
+    ``copy.deepcopy``) leaves that out: the optimiser comes back with its
+    hyper-parameters and no state, each callback as freshly initialised. The
+    module, the criterion and the history are kept, so a net and its
+    unpickled copy predict identically and the copy can be fitted again;
+    ``partial_fit`` (``warm_start``) after unpickling continues from the
+    weights with a fresh optimiser state, not where training stopped.
+    """
+
+    def __getstate__(self):
+        memo = {}
+        lean = object.__new__(type(self))
+        for name, value in vars(self).items():
+            if name == "callbacks" or name.startswith("callbacks_"):
+                value = _lean_callbacks(value, memo)
+            elif name.endswith("_") and name[:-1] in self._optimizers:
+                value = _stateless(value)
+            vars(lean)[name] = value
+        return NeuralNet.__getstate__(lean)
+
+
+def _stateless(optimizer):
+    """A copy of ``optimizer`` (same parameters and hyper-parameters) without state."""
+    if not isinstance(optimizer, torch.optim.Optimizer):
+        return optimizer
+    new = object.__new__(type(optimizer))
+    new.__setstate__(
+        {
+            "defaults": optimizer.defaults,
+            "state": defaultdict(dict),
+            "param_groups": optimizer.param_groups,
+        }
+    )
+    return new
+
+
+def _lean_callbacks(value, memo):
+    """``value`` (a callback or a list of them, named or not) with every callback
+    replaced by a copy as initialised, without what training set on it."""
+    if isinstance(value, (list, tuple)):
+        return type(value)(_lean_callbacks(v, memo) for v in value)
+    if not isinstance(value, Callback):
+        return value
+    if id(value) not in memo:
+        new = copy.copy(value)
+        for key in [k for k in vars(new) if k.endswith("_") and k[:1] != "_"]:
+            delattr(new, key)  # skorch's rule: set by initialize and training
+        memo[id(value)] = new.initialize()
+    return memo[id(value)]
 
 
 class MatlabCrossEntropy(nn.CrossEntropyLoss):
@@ -387,7 +448,7 @@ class FramewiseNetwork(BaseEstimator):
             callbacks.append(("early_stopping", stopper))
         if self.verbose and not lines:
             callbacks.append(("progress", EpochProgress()))
-        net = NeuralNet(
+        net = LeanNet(
             module,
             **{f"module__{k}": v for k, v in (module_params or {}).items()},
             criterion=FramewiseLoss,
@@ -447,7 +508,7 @@ def build_net(
     device="cpu",
     verbose=0,
 ):
-    """An unfitted skorch ``NeuralNet`` around :class:`MLPModule`.
+    """An unfitted skorch net (a :class:`LeanNet`) around :class:`MLPModule`.
 
     ``loss="binary"`` uses a sigmoid output with binary cross-entropy,
     ``"multiclass"`` a softmax output with cross-entropy averaged over samples and
@@ -468,7 +529,7 @@ def build_net(
         callbacks.append(("progress", EpochProgress()))
     # verbose >= 2: skorch's own default callbacks (epoch timer, print log) print
     # one line per epoch once the net is verbose.
-    return NeuralNet(
+    return LeanNet(
         MLPModule,
         criterion=criterion,
         optimizer=optimizer,
