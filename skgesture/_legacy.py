@@ -46,7 +46,25 @@ MOVED = {
 }
 
 
+# Names of 0.1 that a later class replaced: (old module, old name) -> (module,
+# name). One train_split class replaced three.
+RENAMED = {
+    ("skgesture._networks", "_TrainOnly"): ("skgesture._nn._training", "SequenceSplit"),
+    ("skgesture._tagger", "_HoldOutSequences"): (
+        "skgesture._nn._training",
+        "SequenceSplit",
+    ),
+    ("skgesture._bilstm", "_SequenceHoldout"): (
+        "skgesture._nn._training",
+        "SequenceSplit",
+    ),
+}
+
+
 def _lookup(old, name):
+    if (old, name) in RENAMED:
+        module, new = RENAMED[old, name]
+        return getattr(importlib.import_module(module), new)
     for target in MOVED[old]:
         module = importlib.import_module(target)
         if name in vars(module):

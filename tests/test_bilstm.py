@@ -20,13 +20,12 @@ from sklearn.pipeline import Pipeline  # noqa: E402
 
 from skgesture import BiLSTMTagger, PoseDescriptor, make_method_c  # noqa: E402
 from skgesture._nn._modules import RecurrentTaggerModule, _BiLSTMModule  # noqa: E402
-from skgesture._nn._training import FramewiseLoss  # noqa: E402
+from skgesture._nn._training import FramewiseLoss, SequenceSplit  # noqa: E402
 from skgesture._taggers._bilstm import (  # noqa: E402
     IGNORE_INDEX,
     PAPER_MODULE,
     _BiLSTMNet,
     _chunks,
-    _SequenceHoldout,
     _training_windows,
     sample_windows,
 )
@@ -163,7 +162,7 @@ def test_inference_chunks():
 
 def test_sequence_holdout_keeps_sequences_whole():
     seq = np.repeat(np.arange(10), 3)
-    train, valid = _SequenceHoldout(0.2, seq, 0)(list(range(30)))
+    train, valid = SequenceSplit(0.2, 0, seq)(list(range(30)))
     held = np.unique(seq[valid.indices])
     assert len(held) == 2
     assert not np.isin(seq[train.indices], held).any()

@@ -17,9 +17,11 @@ torch = pytest.importorskip("torch")
 from sklearn.base import clone  # noqa: E402
 
 from skgesture import BiLSTMTagger, SequenceTagger  # noqa: E402
-from skgesture._nn._sequence_net import _HoldOutSequences  # noqa: E402
-from skgesture._nn._training import FramewiseLoss, held_out_sequences  # noqa: E402
-from skgesture._taggers._bilstm import _SequenceHoldout  # noqa: E402
+from skgesture._nn._training import (  # noqa: E402
+    FramewiseLoss,
+    SequenceSplit,
+    held_out_sequences,
+)
 
 TAGGERS = {
     "bilstm": lambda **p: BiLSTMTagger(hidden_sizes=(4,), max_epochs=2, **p),
@@ -147,21 +149,23 @@ def test_early_stopping_holds_out_whole_sequences(kind):
         clone(tagger).fit(X[:1], y[:1])
 
 
-def test_both_samplers_hold_out_the_same_sequences():
+def test_one_split_holds_out_the_same_sequences_of_windows_and_crops():
+    from skgesture._nn._sequence_net import _CropData
+
     # Windows of 6 sequences (several per sequence) and the 6 sequences whole.
     seq = np.repeat(np.arange(6), [3, 1, 4, 2, 2, 5])
-    _, valid = _SequenceHoldout(0.34, seq, 7)(list(range(len(seq))))
+    _, valid = SequenceSplit(0.34, 7, seq)(list(range(len(seq))))
     held = np.unique(seq[valid.indices])
-
-    class _Data:
-        X = [np.zeros((5, 2), np.float32)] * 6
-        y = [np.zeros(5, np.int64)] * 6
-        crop_length, augmenter = 4, None
-        mean, scale = np.zeros(2), np.ones(2)
-
-    _, whole = _HoldOutSequences(0.34, 7)(_Data())
-    assert len(whole) == len(held) == 2
+    X = [np.full((5, 2), i, np.float32) for i in range(6)]
+    y = [np.zeros(5, np.int64)] * 6
+    data = _CropData(X, y, crop_length=4, augmenter=None, mean=np.zeros(2),
+                     scale=np.ones(2), seed=7)  # fmt: skip
+    train, whole = SequenceSplit(0.34, 7)(data)
+    assert len(whole) == len(held) == 2 and len(train) == 4
     assert sorted(held) == sorted(held_out_sequences(6, 0.34, 7))
+    assert sorted(int(x[0, 0]) for x in whole.X) == sorted(held)
+    # No validation: everything trains.
+    assert SequenceSplit()(data) == (data, None)
 
 
 @pytest.mark.parametrize("kind, bar_at_1", [("bilstm", False), ("sequence", True)])

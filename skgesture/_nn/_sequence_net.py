@@ -18,7 +18,7 @@ from skgesture._nn._modules import (
 from skgesture._nn._training import (
     IGNORE_INDEX,
     FramewiseNetwork,
-    held_out_sequences,
+    SequenceSplit,
     seed_from,
 )
 
@@ -40,10 +40,29 @@ class _CropData(torch.utils.data.Dataset):
         self.augmenter = augmenter
         self.mean = mean.astype(np.float32)
         self.scale = scale.astype(np.float32)
+        self.seed = seed
         self.rng = np.random.RandomState(seed)
 
     def __len__(self):
         return len(self.X)
+
+    def split(self, keep, held):
+        """Crops of the sequences ``keep`` to train on (a fresh draw from the
+        same seed) and the sequences ``held`` whole, to validate on
+        (``SequenceSplit``)."""
+        train = _CropData(
+            [self.X[i] for i in keep],
+            [self.y[i] for i in keep],
+            crop_length=self.crop_length,
+            augmenter=self.augmenter,
+            mean=self.mean,
+            scale=self.scale,
+            seed=self.seed,
+        )
+        valid = _WholeSequences(
+            [self.X[i] for i in held], [self.y[i] for i in held], self.mean, self.scale
+        )
+        return train, valid
 
     def __getitem__(self, i):
         raise TypeError("crops are drawn in batches by _CropBatches")
@@ -113,35 +132,6 @@ class _OneSequenceBatches:
         for i in range(len(self.dataset)):
             x, y = self.dataset[i]
             yield x[None], y[None]
-
-
-class _HoldOutSequences:
-    """skorch ``train_split``: whole sequences held out for validation."""
-
-    def __init__(self, fraction, seed):
-        self.fraction = fraction
-        self.seed = seed
-
-    def __call__(self, dataset, y=None, **kwargs):
-        n = len(dataset.X)
-        held = held_out_sequences(n, self.fraction, self.seed)
-        keep = np.setdiff1d(np.arange(n), held)
-        train = _CropData(
-            [dataset.X[i] for i in keep],
-            [dataset.y[i] for i in keep],
-            crop_length=dataset.crop_length,
-            augmenter=dataset.augmenter,
-            mean=dataset.mean,
-            scale=dataset.scale,
-            seed=self.seed,
-        )
-        valid = _WholeSequences(
-            [dataset.X[i] for i in held],
-            [dataset.y[i] for i in held],
-            dataset.mean,
-            dataset.scale,
-        )
-        return train, valid
 
 
 class WarmupCosine:
@@ -298,7 +288,7 @@ class _CropNet(FramewiseNetwork):
             data,
             seed=seed,
             n_sequences=len(X),
-            train_split=_HoldOutSequences(self.validation_fraction, seed),
+            train_split=SequenceSplit(self.validation_fraction, seed),
             callbacks=schedule,
             module_params={
                 "n_inputs": int(frames.shape[1]),

@@ -35,6 +35,7 @@ __all__ = [
     "FramewiseLoss",
     "FramewiseNetwork",
     "LeanNet",
+    "SequenceSplit",
     "MLPModule",
     "build_net",
     "fit_cached",
@@ -199,11 +200,67 @@ class ArrayLoader:
             yield X[idx], (y[idx] if y is not None else torch.zeros(0))
 
 
-class _TrainOnly:
-    """skorch ``train_split`` that keeps every sample for training."""
+class SequenceSplit:
+    """The skorch ``train_split`` of skgesture's networks: whole sequences held out.
 
-    def __call__(self, dataset, y=None):
-        return dataset, None
+    Frames of one sequence (or overlapping windows of it) are too alike for a
+    split of samples to validate on unseen data, so validation holds out whole
+    sequences: ``held_out_sequences(n, fraction, seed)`` of them.
+
+    Parameters
+    ----------
+    fraction : float or None, default=None
+        Share of the sequences held out for validation; ``None`` trains on
+        everything and validates on nothing.
+    seed : int or None, default=None
+        Seed of the draw.
+    sequence_ids : ndarray of shape (n_samples,) or None, default=None
+        The sequence of each sample, for a dataset of windows (Method C):
+        the split is two ``Subset``s of the dataset. ``None``: the dataset's
+        items are whole sequences (``dataset.X``), and it makes its own two
+        parts with ``dataset.split(keep, held)`` (crops to train on, whole
+        sequences to validate on).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._nn._training import SequenceSplit
+    >>> seq = np.repeat(np.arange(5), 2)  # two windows per sequence
+    >>> train, valid = SequenceSplit(0.2, seed=0, sequence_ids=seq)(list(range(10)))
+    >>> len(train), len(valid), len(set(seq[valid.indices]))
+    (8, 2, 1)
+    """
+
+    def __init__(self, fraction=None, seed=None, sequence_ids=None):
+        self.fraction = fraction
+        self.seed = seed
+        self.sequence_ids = sequence_ids
+
+    def __call__(self, dataset, y=None, **kwargs):
+        if self.fraction is None:
+            return dataset, None
+        if self.sequence_ids is not None:
+            ids = np.unique(self.sequence_ids)
+            held = ids[held_out_sequences(len(ids), self.fraction, self.seed)]
+            valid = np.isin(self.sequence_ids, held)
+            return (
+                torch.utils.data.Subset(dataset, np.flatnonzero(~valid)),
+                torch.utils.data.Subset(dataset, np.flatnonzero(valid)),
+            )
+        n = len(dataset.X)
+        held = held_out_sequences(n, self.fraction, self.seed)
+        return dataset.split(np.setdiff1d(np.arange(n), held), held)
+
+    def __setstate__(self, state):
+        # Pickles of 0.1 hold _TrainOnly (no state), _HoldOutSequences
+        # (fraction, seed) or _SequenceHoldout (fraction, sequence_ids,
+        # random_state): skgesture._legacy maps those names to this class.
+        state = dict(state)
+        if "random_state" in state:
+            state["seed"] = state.pop("random_state")
+        for key in ("fraction", "seed", "sequence_ids"):
+            state.setdefault(key, None)
+        self.__dict__.update(state)
 
 
 class _MatlabStopping(Callback):
@@ -523,7 +580,7 @@ def build_net(
     if validation_fraction > 0:
         split = _MatlabDivision(validation_fraction, test_fraction, seed)
     else:
-        split = _TrainOnly()
+        split = SequenceSplit()  # no validation
     callbacks = [("matlab_stop", _MatlabStopping(max_fail=max_fail))]
     if verbose == 1:
         callbacks.append(("progress", EpochProgress()))

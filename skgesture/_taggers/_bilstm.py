@@ -30,7 +30,7 @@ from skgesture._nn._training import (
     IGNORE_INDEX,
     FramewiseLoss,
     FramewiseNetwork,
-    held_out_sequences,
+    SequenceSplit,
     seed_from,
 )
 from skgesture._stream import DEFAULT_MAX_PERIOD
@@ -175,28 +175,6 @@ class _StepCrossEntropy(FramewiseLoss):
         self._buffers.setdefault("weight", None)
 
 
-class _SequenceHoldout:
-    """skorch ``train_split`` holding out whole sequences for validation.
-
-    Windows overlap by up to 8 of their 10 frames, so a random split of windows
-    would validate on frames seen in training; whole sequences are held out.
-    """
-
-    def __init__(self, fraction, sequence_ids, random_state):
-        self.fraction = fraction
-        self.sequence_ids = sequence_ids
-        self.random_state = random_state
-
-    def __call__(self, dataset, y=None, **kwargs):
-        ids = np.unique(self.sequence_ids)
-        held = ids[held_out_sequences(len(ids), self.fraction, self.random_state)]
-        valid = np.isin(self.sequence_ids, held)
-        return (
-            torch.utils.data.Subset(dataset, np.flatnonzero(~valid)),
-            torch.utils.data.Subset(dataset, np.flatnonzero(valid)),
-        )
-
-
 class _BiLSTMNet(FramewiseNetwork):
     """The trainable part of :class:`BiLSTMTagger`, cached by ``fit_cached``.
 
@@ -277,7 +255,7 @@ class _BiLSTMNet(FramewiseNetwork):
             yw,
             seed=seed,
             n_sequences=len(X),
-            train_split=_SequenceHoldout(self.validation_fraction, seq, seed),
+            train_split=SequenceSplit(self.validation_fraction, seed, seq),
             callbacks=schedule,
             module_params={
                 "n_inputs": Xw.shape[2],
