@@ -33,7 +33,7 @@ from skgesture.datasets._base import (
     _warn,
 )
 from skgesture.layouts import N_COORDS, N_KINECT_JOINTS
-from skgesture.utils._segments import labels_to_segments
+from skgesture.utils._segments import from_file_lines, labels_to_segments, to_file_lines
 
 __all__ = [
     "CHALEARN_GESTURE_NAMES",
@@ -266,7 +266,7 @@ def _parse_labels(lines, name, n_frames=None):
         else:
             why = f"end frame {e} is beyond the last frame {n_frames}"
         raise _format_error(name, i + 1, f"{why} (line {lines[i].strip()!r})")
-    return np.stack([cls, start - 1, end], axis=1)
+    return from_file_lines(np.stack([cls, start, end], axis=1))
 
 
 def read_chalearn_labels(file, *, n_frames=None):
@@ -685,7 +685,7 @@ def _as_prediction_segments(pred, sid, n_frames):
             f"{sid}: expected per-frame labels of shape (n_frames,) or segments of "
             f"shape (n, 3), got shape {arr.shape}"
         )
-    start = np.maximum(seg[:, 1] + 1, 1)  # 1-based, docs/method.md §2.2 clamping
+    start = np.maximum(to_file_lines(seg)[:, 1], 1)  # docs/method.md §2.2 clamping
     end = seg[:, 2] if n_frames is None else np.minimum(seg[:, 2], n_frames)
     outside = start > end
     if outside.any():

@@ -18,7 +18,7 @@ import numpy as np
 from sklearn.exceptions import UndefinedMetricWarning
 
 from skgesture.metrics._segmental import REST, _check_label_pairs
-from skgesture.utils._segments import check_segments, labels_to_segments
+from skgesture.utils._segments import check_segments, labels_to_segments, to_file_lines
 
 __all__ = ["jaccard_index", "jaccard_index_segments"]
 
@@ -250,19 +250,9 @@ def jaccard_index_segments(
     return score
 
 
-def _segments_to_lines(seg):
-    """File lines of segments: 1-based start, inclusive end (rows modified in place).
-
-    A 0-based start becomes 1-based; the exclusive 0-based end is already the
-    1-based number of the last frame.
-    """
-    seg[:, 1] += 1
-    return seg
-
-
 def _labels_to_lines(y):
     """File lines of a per-frame labelling: one per maximal gesture run (§1.7)."""
-    return _segments_to_lines(labels_to_segments(y, rest=REST))
+    return to_file_lines(labels_to_segments(y, rest=REST))
 
 
 def _true_segment_lines(true_segments, y_true):
@@ -282,7 +272,7 @@ def _true_segment_lines(true_segments, y_true):
     lines = []
     for i, (seg, yt) in enumerate(zip(true_segments, y_true)):
         seg = check_segments(seg, len(yt), name=f"true_segments[{i}]")
-        lines.append(_segments_to_lines(seg))
+        lines.append(to_file_lines(seg))
     return lines
 
 

@@ -289,3 +289,55 @@ def _chunks(n_frames, window, overlap):
     if starts[-1] != n_frames - window:
         starts.append(n_frames - window)
     return [(s, s + window) for s in starts]
+
+
+def to_file_lines(segments):
+    """The ``(class, start, end)`` lines of a label file, from segments.
+
+    The package's segments are 0-based with an exclusive end; the ChaLearn
+    label and prediction files are 1-based with an inclusive end
+    (docs/method.md §1.7), so the start gains one and the end stays (the
+    exclusive 0-based end is the 1-based number of the last frame). The one
+    conversion of the package; :func:`from_file_lines` is its inverse.
+
+    Parameters
+    ----------
+    segments : array-like of int of shape (n, 3)
+        ``(class, start, end)`` rows, 0-based, end exclusive.
+
+    Returns
+    -------
+    ndarray of int64 of shape (n, 3)
+        A new array of 1-based inclusive rows.
+
+    Examples
+    --------
+    >>> from skgesture.utils._segments import from_file_lines, to_file_lines
+    >>> to_file_lines([[3, 0, 10]]).tolist()
+    [[3, 1, 10]]
+    >>> from_file_lines([[3, 1, 10]]).tolist()
+    [[3, 0, 10]]
+    """
+    lines = np.array(segments, dtype=np.int64).reshape(-1, 3)
+    lines[:, 1] += 1
+    return lines
+
+
+def from_file_lines(lines):
+    """Segments (0-based, end exclusive) from 1-based inclusive file lines.
+
+    The inverse of :func:`to_file_lines`.
+
+    Parameters
+    ----------
+    lines : array-like of int of shape (n, 3)
+        ``(class, start, end)`` lines, 1-based, end inclusive.
+
+    Returns
+    -------
+    ndarray of int64 of shape (n, 3)
+        A new array of 0-based rows with an exclusive end.
+    """
+    segments = np.array(lines, dtype=np.int64).reshape(-1, 3)
+    segments[:, 1] -= 1
+    return segments
