@@ -496,13 +496,20 @@ def _input_layout(estimator):
         "joints": None,
     }
     from skgesture._descriptor._estimator import PoseDescriptor
+    from skgesture._features import JointFeatures
 
-    if isinstance(first, PoseDescriptor):
+    if isinstance(first, (PoseDescriptor, JointFeatures)):
+        # Both read raw Kinect v1 skeletons (other layouts are mapped first).
         from skgesture.layouts import KINECT_V1
 
         info["layout"] = KINECT_V1.name
         joints = first.joints
-        info["joints"] = joints if isinstance(joints, str) else getattr(joints, "name")
+        if isinstance(joints, str):
+            info["joints"] = joints
+        elif hasattr(joints, "name"):  # a DescriptorJoints
+            info["joints"] = joints.name
+        else:  # JointFeatures: a list of joint names
+            info["joints"] = [str(j) for j in joints]
     return info
 
 
@@ -525,7 +532,7 @@ def _sha256(data):
 # -- public API -------------------------------------------------------------------
 
 
-def save_model(estimator, path, *, metadata=None, overwrite=True):
+def save_model(estimator, path, *, metadata=None, overwrite=False):
     """Write an estimator to one safe model file (skops + safetensors).
 
     Any scikit-learn estimator or pipeline of skgesture can be saved, fitted or
@@ -546,9 +553,10 @@ def save_model(estimator, path, *, metadata=None, overwrite=True):
     metadata : dict or None, default=None
         JSON-serialisable information stored with the model (for example the
         class names and the data it was trained on); ``model_info`` reads it.
-    overwrite : bool, default=True
-        Replace an existing file. With False an existing ``path`` raises
-        ``FileExistsError``.
+    overwrite : bool, default=False
+        Replace an existing file. By default an existing ``path`` raises
+        ``FileExistsError``, as the command line refuses to overwrite without
+        ``--overwrite``: a model is never replaced by accident.
 
     Returns
     -------
@@ -756,6 +764,9 @@ def _check_layout(path, manifest, layout):
         return
     info = manifest.get("input") or {}
     if isinstance(layout, str):
+        from skgesture.streaming import get_adapter
+
+        get_adapter(layout)  # a misspelt layout name is an error, not a pass
         if info.get("layout") is not None and info["layout"] != layout:
             raise LayoutMismatchError(
                 f"{path} expects skeletons of layout {info['layout']!r}, the data "
@@ -959,7 +970,8 @@ def load_model(path, *, trusted=None, layout=None, allow_version_mismatch=False)
     layout : str, tuple of int or None, default=None
         The skeleton layout name (e.g. ``"kinect_v1"``) or frame shape (e.g.
         ``(20, 3)``) of the data the model will be used on; a model trained on
-        another layout raises ``LayoutMismatchError``.
+        another layout raises ``LayoutMismatchError``, and a name that is no
+        known layout (``skgesture.streaming.get_adapter``) a ``ValueError``.
     allow_version_mismatch : bool, default=False
         Load a file written by another major.minor version of skgesture (with
         a warning) instead of raising ``ModelVersionError``.

@@ -155,8 +155,14 @@ def test_round_trip_recommended(data, tmp_path):
     pipe.set_params(**{f"{pipe.steps[-1][0]}__{k}": v for k, v in tiny.items()})
     with torch.random.fork_rng(devices=[]):
         pipe.fit(data.X, data.y)
-    loaded = load_model(save_model(pipe, tmp_path / "rec.skg"))
+    path = save_model(pipe, tmp_path / "rec.skg")
+    loaded = load_model(path)
     _assert_same_predictions(pipe, loaded, data.X)
+    # The manifest says what the model reads (it said null before).
+    assert model_info(path)["input"]["layout"] == "kinect_v1"
+    assert model_info(path)["input"]["joints"] == pipe[0].joints
+    with pytest.raises(ValueError, match="unknown layout"):
+        load_model(path, layout="kinect2")
 
 
 def test_bare_net_with_tensor_and_array_parameters(tmp_path):
@@ -336,9 +342,25 @@ def test_model_info_records_version_layout_and_metadata(fitted, tmp_path):
     assert len(info["nets"]) == 4  # segmenter + one network per time scale
 
 
-def test_overwrite_false_refuses_an_existing_file(saved_b, fitted):
+def test_an_existing_file_is_refused_unless_overwrite(saved_b, fitted):
+    before = saved_b.read_bytes()
+    with pytest.raises(FileExistsError, match="exists"):
+        save_model(fitted["B"], saved_b)  # the default, as the CLI
     with pytest.raises(FileExistsError, match="exists"):
         save_model(fitted["B"], saved_b, overwrite=False)
+    assert saved_b.read_bytes() == before  # nothing lost
+    save_model(fitted["B"], saved_b, overwrite=True)
+    assert load_model(saved_b) is not None
+
+
+def test_misspelt_layout_name_is_an_error(saved_b):
+    load_model(saved_b, layout="kinect_v1")
+    with pytest.raises(
+        ValueError, match="unknown layout 'kinect2'; known: .*kinect_v2"
+    ):
+        load_model(saved_b, layout="kinect2")
+    with pytest.raises(LayoutMismatchError, match="kinect_v1"):
+        load_model(saved_b, layout="kinect_v2")
 
 
 # -- never pickle, refuse what is not trusted ------------------------------------
@@ -659,5 +681,5 @@ def test_layout_mismatch_is_refused(saved_b):
     assert load_model(saved_b, layout=(20, 3)) is not None
     with pytest.raises(LayoutMismatchError, match=r"\(20, 3\).*\(33, 3\)"):
         load_model(saved_b, layout=(33, 3))
-    with pytest.raises(LayoutMismatchError, match="'kinect_v1'.*'mediapipe'"):
-        load_model(saved_b, layout="mediapipe")
+    with pytest.raises(LayoutMismatchError, match="'kinect_v1'.*'mediapipe_pose'"):
+        load_model(saved_b, layout="mediapipe_pose")
