@@ -15,6 +15,10 @@ outcomes are:
 
 Anything else (a bare numpy/Overflow/Index/UnicodeDecode error, a silent
 garbage array, a RuntimeWarning) fails the test and is listed.
+
+The header mutations of a skeleton file (a deleted, duplicated, unknown,
+misspelt, swapped or empty column, a trailing separator, a short row) must read
+the right values by name or raise a DataFormatError naming the column and line.
 """
 
 import re
@@ -25,6 +29,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from numpy.testing import assert_allclose
 
 from skgesture.datasets import (
     CHALEARN_GESTURE_NAMES,
@@ -38,6 +43,7 @@ from skgesture.datasets import (
     load_recordings,
     load_utkinect,
     read_chalearn_labels,
+    read_skeleton_csv,
     write_intervals,
 )
 
@@ -410,3 +416,242 @@ def test_loader_fuzz_raises_only_documented_errors(shared_data, tmp_path, target
     assert outcomes["error"] > 0  # the mutations do reach the checks
     # Record the counts for the summary (`pytest -rA` or the test log).
     print(f"{target}: {sum(outcomes.values())} cases, {dict(outcomes)}")
+
+
+# ----------------------------------------------------------------------------
+# Header mutations: the header's names decide the columns of a skeleton file
+# ----------------------------------------------------------------------------
+
+
+def _skeleton_text(names, rows, sep=","):
+    lines = [sep.join(names)] if names is not None else []
+    return "\n".join(lines + [sep.join(r) for r in rows]) + "\n"
+
+
+def _kinect_v2_table(n_frames=8, seed=0):
+    """Header names, rows of text and the Kinect v1 frames they should read as."""
+    from skgesture.streaming import KINECT_V2_JOINTS, KinectV2Adapter
+
+    v2 = np.round(np.random.default_rng(seed).uniform(-1, 3, (n_frames, 25, 3)), 4)
+    names = ["frame"] + [f"{j}_{a}" for j in KINECT_V2_JOINTS for a in "xyz"]
+    rows = [
+        [str(100 + i)] + [f"{v:.4f}" for v in v2[i].ravel()] for i in range(n_frames)
+    ]
+    return names, rows, KinectV2Adapter()(v2)
+
+
+def _precog_table(shared):
+    """A real PRECOG sequence (Kinect v1) as header names and rows of text."""
+    from skgesture.layouts import KINECT_V1
+
+    x = load_precog(shared / "precog_2016" / "CSV" / "Seq1_1.csv").X[0][:N_FRAMES]
+    names = ["frame"] + [f"{j}_{a}" for j in KINECT_V1.joint_names for a in "xyz"]
+    rows = [[str(i)] + [f"{v:.9g}" for v in x[i].ravel()] for i in range(len(x))]
+    return names, rows
+
+
+def _columns(order):
+    """Mutation keeping the columns ``order(list of indices)`` of header and rows."""
+
+    def mutate(names, rows):
+        idx = order(list(range(len(names))))
+        return [names[i] for i in idx], [[r[i] for i in idx] for r in rows]
+
+    return mutate
+
+
+def _swap(a, b):
+    def order(c):
+        c[a], c[b] = c[b], c[a]
+        return c
+
+    return _columns(order)
+
+
+def _rename(i, new):
+    def mutate(names, rows):
+        names = list(names)
+        names[i] = new(names) if callable(new) else new
+        return names, rows
+
+    return mutate
+
+
+def _row(k, change):
+    def mutate(names, rows):
+        rows = [list(r) for r in rows]
+        rows[k] = change(rows[k])
+        return names, rows
+
+    return mutate
+
+
+def _shuffle(names, rows):
+    perm = np.random.default_rng(SEED).permutation(len(names)).tolist()
+    return _columns(lambda c: [c[i] for i in perm])(names, rows)
+
+
+# id: (mutation of (names, rows), None = reads the right values, or
+#      (regex of the message, 1-based line of the error))
+HEADER_MUTATIONS = {
+    "delete_last_z": (_columns(lambda c: c[:-1]), (r"no column \w+_z\b", 1)),
+    "delete_a_y": (_columns(lambda c: c[:5] + c[6:]), (r"no column \w+_y\b", 1)),
+    "delete_frame": (_columns(lambda c: c[1:]), None),
+    "delete_a_name_only": (lambda n, r: (n[:5] + n[6:], r), (r"no column \w+_y", 1)),
+    "duplicate_column": (_columns(lambda c: c + [4]), (r"'\w+_x' appears 2 times", 1)),
+    "duplicate_name": (
+        _rename(4, lambda n: n[1]),
+        (r"'\w+_x' appears 2 times .*; the header has no column \w+_x", 1),
+    ),
+    "unknown_name": (_rename(4, "Foo"), (r"column\(s\) 'Foo' name no coordinate", 1)),
+    "unknown_column_added": (
+        lambda n, r: (n + ["comment"], [x + ["1"] for x in r]),
+        (r"'comment' name no coordinate", 1),
+    ),
+    "empty_name": (_rename(4, ""), (r"column\(s\) 5 of the header have no name", 1)),
+    "swap_axes": (_swap(1, 2), None),
+    "swap_joints": (_swap(1, -1), None),
+    "frame_last": (_columns(lambda c: c[1:] + [0]), None),
+    "shuffle": (_shuffle, None),
+    "misspelt_suffix_xx": (
+        _rename(4, lambda n: n[4] + "x"),
+        (r"'\w+_xx' name no coordinate.*no column \w+_x\b", 1),
+    ),
+    "misspelt_suffix_q": (
+        _rename(-1, lambda n: n[-1][:-1] + "q"),
+        (r"'\w+_q' name no coordinate.*no column \w+_z\b", 1),
+    ),
+    "case_and_separator": (
+        lambda n, r: (
+            [re.sub(r"_([xyz])$", lambda m: "." + m[1].upper(), t) for t in n],
+            r,
+        ),
+        None,
+    ),
+    "trailing_empty_column": (
+        lambda n, r: (n + [""], [x + [""] for x in r]),
+        None,
+    ),
+    "trailing_separator_on_header_only": (lambda n, r: (n + [""], r), None),
+    "fewer_values_in_a_row": (_row(2, lambda x: x[:-1]), (r"expected \d+ values", 4)),
+    "fewer_values_in_first_row": (_row(0, lambda x: x[:-1]), (r"expected \d+ val", 2)),
+    "more_values_in_a_row": (_row(3, lambda x: x + ["0.5"]), (r"expected \d+ val", 5)),
+}
+
+
+def _check_header_case(path, read, names, rows, want, mutation, expect):
+    names, rows = mutation(names, rows)
+    path.write_text(_skeleton_text(names, rows))
+    if expect is None:
+        X, numbers = read(path)
+        assert_allclose(X, want, rtol=0, atol=1e-12)
+        if "frame" in names:
+            assert numbers.tolist() == [int(r[names.index("frame")]) for r in rows]
+        else:
+            assert numbers is None
+        return
+    match, line = expect
+    with pytest.raises(DataFormatError, match=match) as info:
+        read(path)
+    assert (info.value.file, info.value.line) == (path.name, line)
+    assert str(info.value).startswith(f"{path.name} line {line}: ")
+
+
+@pytest.mark.parametrize("case", sorted(HEADER_MUTATIONS))
+def test_kinect_v2_header_mutations(tmp_path, case):
+    names, rows, want = _kinect_v2_table()
+
+    def read(path):
+        return read_skeleton_csv(path, layout="kinect_v2", return_frame_numbers=True)
+
+    _check_header_case(
+        tmp_path / "v2.csv", read, names, rows, want, *HEADER_MUTATIONS[case]
+    )
+
+
+def test_real_recording_header_mutations(shared_data, tmp_path):
+    names, rows = _precog_table(shared_data)
+    path = tmp_path / "take1.csv"
+    path.write_text(_skeleton_text(names, rows))
+    want = read_skeleton_csv(path)
+    assert_allclose(
+        want,
+        load_precog(shared_data / "precog_2016" / "CSV" / "Seq1_1.csv").X[0][:N_FRAMES],
+    )
+
+    def read(path):
+        return read_skeleton_csv(path, return_frame_numbers=True)
+
+    failures = []
+    for case, (mutation, expect) in sorted(HEADER_MUTATIONS.items()):
+        try:
+            _check_header_case(path, read, names, rows, want, mutation, expect)
+        except Exception as exc:  # noqa: BLE001 - list every case that fails
+            failures.append(f"{case}: {type(exc).__name__}: {str(exc)[:300]}")
+    assert not failures, "\n".join(failures)
+
+
+def test_kinect_v2_missing_column_is_not_read_as_shifted_data(tmp_path):
+    """The case of the issue: ``frame`` and 74 of the 75 joint columns."""
+    names, rows, want = _kinect_v2_table()
+    gone = names.index("ThumbRight_z")
+    keep = [i for i in range(len(names)) if i != gone]
+    path = tmp_path / "v2.csv"
+    path.write_text(_skeleton_text(names, rows))
+    assert_allclose(read_skeleton_csv(path, layout="kinect_v2"), want, atol=1e-12)
+    path.write_text(
+        _skeleton_text([names[i] for i in keep], [[r[i] for i in keep] for r in rows])
+    )
+    with pytest.raises(DataFormatError, match="no column ThumbRight_z") as info:
+        read_skeleton_csv(path, layout="kinect_v2")
+    assert info.value.file == "v2.csv" and str(info.value).startswith("v2.csv line 1")
+    # The same file without its header: 75 values fit 25 joints without a frame
+    # number, but the first value of every line counts frames.
+    path.write_text(_skeleton_text(None, [[r[i] for i in keep] for r in rows]))
+    with pytest.raises(DataFormatError, match="looks like a frame number") as info:
+        read_skeleton_csv(path, layout="kinect_v2")
+    assert "frame_column=False" in str(info.value) and info.value.file == "v2.csv"
+    # frame_column=False says the first value is a coordinate: read by position
+    got = read_skeleton_csv(path, layout="kinect_v2", frame_column=False)
+    assert got.shape == want.shape and not np.allclose(got, want)
+    with pytest.raises(DataFormatError, match="expected 75 or 100 values \\+ 1"):
+        read_skeleton_csv(path, layout="kinect_v2", frame_column=True)
+    # the intact file without header reads as before, with or without frames
+    path.write_text(_skeleton_text(None, rows))
+    X, numbers = read_skeleton_csv(path, layout="kinect_v2", return_frame_numbers=True)
+    assert_allclose(X, want, atol=1e-12) and numbers[0] == 100
+    path.write_text(_skeleton_text(None, [r[1:] for r in rows]))
+    assert_allclose(read_skeleton_csv(path, layout="kinect_v2"), want, atol=1e-12)
+
+
+def test_value_count_fitting_two_readings_asks_for_frame_column(tmp_path):
+    """4 values of a 1-joint layout: a frame number and x, y, z, or x, y, z, c."""
+    from skgesture.streaming import SkeletonAdapter
+
+    class OneJoint(SkeletonAdapter):
+        n_joints = 1
+        name = "one_joint"
+
+        def _convert(self, X):
+            return np.repeat(X, 20, axis=1)
+
+    rows = [[str(i), "0.1", "0.2", "0.3"] for i in range(5)]
+    path = tmp_path / "one.csv"
+    path.write_text(_skeleton_text(None, rows))
+    with pytest.raises(
+        DataFormatError, match="fit 4 values per joint or a frame number and 3 values"
+    ) as info:
+        read_skeleton_csv(path, layout=OneJoint())
+    assert "frame_column=True or False" in str(info.value)
+    X, numbers = read_skeleton_csv(
+        path, layout=OneJoint(), frame_column=True, return_frame_numbers=True
+    )
+    assert_allclose(X[:, 0], [[0.1, 0.2, 0.3]] * 5) and numbers.tolist() == [
+        0,
+        1,
+        2,
+        3,
+        4,
+    ]
+    X = read_skeleton_csv(path, layout=OneJoint(), frame_column=False)
+    assert_allclose(X[:, 0], [[i, 0.1, 0.2] for i in range(5)])

@@ -176,6 +176,21 @@ def test_skeleton_reader_option_errors(tmp_path):
         read_skeleton_csv(path, layout="kinect_v2")
 
 
+def test_skeleton_header_time_and_confidence_columns_are_recognised(tmp_path):
+    X = _frames()
+    names = [f"{j}_{a}" for j in KINECT_V1.joint_names for a in ("x", "y", "z", "c")]
+    values = np.concatenate([X, np.full((6, 20, 1), 0.7)], axis=2).reshape(6, -1)
+    times = np.arange(6) * 0.033
+    rows = np.column_stack([values, times])  # the timestamp last
+    path = _write(tmp_path / "a.csv", rows, header=",".join(names + ["timestamp"]))
+    got, numbers = read_skeleton_csv(path, return_frame_numbers=True)
+    assert_array_equal(got, X)
+    assert numbers is None  # a timestamp is no frame number
+    rows[3, -1] = 0.0
+    with pytest.raises(DataFormatError, match="a.csv line 5: timestamp 0 is before"):
+        read_skeleton_csv(_write(path, rows, header=",".join(names + ["time"])))
+
+
 # ============================================================================
 # Other layouts through the streaming adapters
 # ============================================================================
@@ -441,3 +456,39 @@ def test_precog_written_as_recordings_reads_back_identical(tmp_path):
         assert back.frame_numbers[k].tolist() == list(range(len(x)))
     assert_array_equal(back.groups[order], data.groups)
     assert_array_equal(back.n_frames[order], data.n_frames)
+
+
+def test_load_recordings_errors_name_the_file_relative_to_the_folder(tmp_path):
+    """alice/take1.csv and bob/take1.csv: the error says which one is broken."""
+    _recording(tmp_path / "alice", "take1", labels="1,4,1\n")
+    _recording(tmp_path / "bob", "take1", labels="1,4,1\n")
+    broken = tmp_path / "bob" / "take1.csv"
+    good = broken.read_text()
+    broken.write_text(good.replace("\n", "\nnot,a,number\n", 1))
+    with pytest.raises(DataFormatError) as info:
+        load_recordings(tmp_path)
+    assert info.value.file == "bob/take1.csv" and info.value.line == 2
+    assert str(info.value).startswith("bob/take1.csv line 2: ")
+    broken.write_bytes(b"caf\xe9\n")  # not UTF-8
+    with pytest.raises(DataFormatError, match="^bob/take1.csv line 1: not a text"):
+        load_recordings(tmp_path)
+    broken.write_text(good)
+    (tmp_path / "alice" / "take1.labels.csv").write_text("1,40,1\n")
+    with pytest.raises(DataFormatError, match="^alice/take1.labels.csv line 1: end"):
+        load_recordings(tmp_path)
+    (tmp_path / "alice" / "take1.labels.csv").write_text("1,4,wave\n")
+    (tmp_path / "classes.txt").write_text("point\n")
+    with pytest.raises(DataFormatError, match="^alice/take1.labels.csv line 1: lab"):
+        load_recordings(tmp_path)
+    (tmp_path / "classes.txt").unlink()
+    (tmp_path / "alice" / "take1.labels.csv").write_text("1,5,1\n3,8,1\n")
+    (tmp_path / "bob" / "ghost.labels.csv").write_text("1,2,1\n")
+    with pytest.warns(DataFileWarning) as record:
+        load_recordings(tmp_path)
+    messages = [str(w.message) for w in record]
+    assert any(m.startswith("alice/take1.labels.csv: overlapping") for m in messages)
+    assert any(m.startswith("bob/ghost.labels.csv: no skeleton") for m in messages)
+    # one file given directly: its own name
+    broken.write_text(good.replace("\n", "\nnot,a,number\n", 1))
+    with pytest.raises(DataFormatError, match="^take1.csv line 2: "):
+        load_recordings(broken)

@@ -150,14 +150,17 @@ def _decode(data, name):
         ) from None
 
 
-def _read_text(path):
-    """Read a text file, raising ValueError naming it when it is not text."""
+def _read_text(path, name=None):
+    """Read a text file, raising ValueError naming it when it is not text.
+
+    ``name`` names the file in the error (default: its base name).
+    """
     path = Path(path)
     try:
         data = path.read_bytes()
     except IsADirectoryError:
         raise ValueError(f"{str(path)!r} is a folder, expected a file") from None
-    return _decode(data, path.name)
+    return _decode(data, path.name if name is None else name)
 
 
 def _lines(text):

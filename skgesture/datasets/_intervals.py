@@ -108,10 +108,13 @@ def _csv_rows(lines, sep):
     return [[t.strip() for t in row] for row in csv.reader(lines, delimiter=sep)]
 
 
-def _read_interval_rows(path):
-    """``[(line, start, end, label token)]`` of an interval file (ints unchecked)."""
-    name = path.name
-    lines = _lines(_read_text(path))
+def _read_interval_rows(path, name=None):
+    """``[(line, start, end, label token)]`` of an interval file (ints unchecked).
+
+    ``name`` names the file in messages (default: its base name).
+    """
+    name = path.name if name is None else name
+    lines = _lines(_read_text(path, name=name))
     numbered = [(i, ln) for i, ln in enumerate(lines, start=1) if ln.strip()]
     if not numbered:
         return []

@@ -103,8 +103,8 @@ def _find_recordings(root):
             key = p.parent / p.stem[: -len(LABELS_TAG)]
             if key in labels:
                 raise ValueError(
-                    f"two annotation files for {key.name}: {labels[key].name} and "
-                    f"{p.name}"
+                    f"two annotation files for {_shown(key, base)}: "
+                    f"{_shown(labels[key], base)} and {_shown(p, base)}"
                 )
             labels[key] = p
         else:
@@ -129,6 +129,11 @@ def _find_recordings(root):
         )
     found.sort(key=lambda f: _natural_key(f[0]))
     return found, sorted(labels.values())
+
+
+def _shown(path, base):
+    """``path`` as messages name it: relative to the folder given (``alice/a.csv``)."""
+    return path.relative_to(base).as_posix()
 
 
 def _groups(sample_ids, pattern):
@@ -221,10 +226,12 @@ def load_recordings(
         (None detects it).
     header : bool or None, default=None
         Whether the skeleton files start with a header line, as in
-        :func:`read_skeleton_csv` (None detects it).
+        :func:`read_skeleton_csv` (None detects it); a header naming the
+        joint columns decides the columns by name.
     frame_column : bool or None, default=None
-        Whether the first value of a line is the frame number, as in
-        :func:`read_skeleton_csv` (None detects it).
+        Whether the skeleton files have a frame-number column, as in
+        :func:`read_skeleton_csv` (None decides, and raises when the layout
+        of the values is ambiguous).
     verbose : int, default=0
         0 is silent; 1 shows a tqdm progress bar over the recordings.
 
@@ -262,7 +269,8 @@ def load_recordings(
         If ``path`` does not exist or holds no skeleton file.
     DataFormatError
         For a malformed skeleton, interval or class-names file, naming the
-        file and the 1-based line.
+        file by its path relative to ``path`` (``alice/take1.csv``; also in
+        its ``file`` attribute) and the 1-based line.
     ValueError
         If only some recordings have an annotation file (with
         ``labels=None``), or none has one with ``labels=True``.
@@ -316,11 +324,14 @@ def load_recordings(
     spec = _Layout(layout)
     root = _check_path(path)
     found, orphans = _find_recordings(root)
+    folder = root if root.is_dir() else root.parent  # files are named from here
     for orphan in orphans:
-        _warn(f"{orphan.name}: no skeleton file {orphan.stem[: -len(LABELS_TAG)]}.*")
+        _warn(
+            f"{_shown(orphan, folder)}: no skeleton file "
+            f"{orphan.stem[: -len(LABELS_TAG)]}.*"
+        )
     sample_ids = [f[0] for f in found]
     group_ids = _groups(sample_ids, groups)
-    folder = root if root.is_dir() else root.parent
     if classes is None and (folder / CLASSES_FILE).is_file():
         classes = folder / CLASSES_FILE
     names = _class_names(classes)
@@ -337,18 +348,27 @@ def load_recordings(
     X, frame_numbers, rows = [], [], []
     for sid, skel, lab in _progress(found, verbose=verbose, desc="recordings"):
         x, numbers = _read_skeleton(
-            skel, spec, delimiter=delimiter, header=header, frame_column=frame_column
+            skel,
+            spec,
+            delimiter=delimiter,
+            header=header,
+            frame_column=frame_column,
+            name=_shown(skel, folder),
         )
         X.append(x)
         frame_numbers.append(numbers)
         if use_labels:
+            shown = _shown(lab, folder)
             rows.append(
-                _convert_frames(_read_interval_rows(lab), lab.name, base, end, len(x))
+                _convert_frames(
+                    _read_interval_rows(lab, shown), shown, base, end, len(x)
+                )
             )
     n_frames = np.array([len(x) for x in X], dtype=np.int64)
     y = segments = None
     if use_labels:
-        y, segments, names = _label_recordings(rows, found, n_frames, names)
+        shown = [_shown(lab, folder) for _, _, lab in found]
+        y, segments, names = _label_recordings(rows, shown, n_frames, names)
     elif names is None:
         names = []
     n_segments = 0 if segments is None else sum(len(s) for s in segments)
@@ -380,8 +400,11 @@ load_recordings.__doc__ = load_recordings.__doc__.format(
 )
 
 
-def _label_recordings(rows, found, n_frames, names):
-    """``(y, segments, target_names)`` of the annotated recordings."""
+def _label_recordings(rows, label_names, n_frames, names):
+    """``(y, segments, target_names)`` of the annotated recordings.
+
+    ``label_names`` names each recording's annotation file in messages.
+    """
     tokens = [label for file_rows in rows for (_, _, _, label) in file_rows]
     numeric = [t for t in tokens if _INT_RE.match(t)]
     if names is None:
@@ -397,8 +420,8 @@ def _label_recordings(rows, found, n_frames, names):
             names = named
     ids = None if names is None else {n: k for k, n in enumerate(names, start=1)}
     y, segments = [], []
-    for file_rows, (_, _, lab), n in zip(rows, found, n_frames):
-        classes = _label_ids(file_rows, lab.name, ids)
+    for file_rows, lab, n in zip(rows, label_names, n_frames):
+        classes = _label_ids(file_rows, lab, ids)
         raw = [(c, s, e) for c, (_, s, e, _) in zip(classes, file_rows) if c]
         lines = [i for c, (i, _, _, _) in zip(classes, file_rows) if c]
         seg, lab_y, overlaps = _sort_and_label(raw, int(n))
@@ -407,7 +430,7 @@ def _label_recordings(rows, found, n_frames, names):
                 f"line {lines[a]} and line {lines[b]}" for a, b in overlaps
             )
             _warn(
-                f"{lab.name}: overlapping intervals: {pairs}; both are kept in "
+                f"{lab}: overlapping intervals: {pairs}; both are kept in "
                 f"`segments`, and in `y` the later-starting one wins"
             )
         y.append(lab_y)

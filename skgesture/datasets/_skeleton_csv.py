@@ -50,6 +50,39 @@ MAX_ABS_RAW_VALUE = 1e7
 UNIT_WARNING_METRES = 50.0
 DELIMITERS = {",": ",", "\t": "\t", ";": ";", " ": None}  # " " = runs of blanks
 _COORD_RE = re.compile(r"^(.*?)[\s_.:/-]*([xyzXYZ])$")
+# Header names (after _norm) of a frame-number column and of a timestamp column.
+FRAME_NAMES = frozenset(
+    {
+        "frame",
+        "frames",
+        "frameno",
+        "framenr",
+        "framenum",
+        "framenumber",
+        "frameid",
+        "frameidx",
+        "frameindex",
+    }
+)
+TIME_NAMES = frozenset(
+    {
+        "t",
+        "time",
+        "times",
+        "timems",
+        "timeus",
+        "timens",
+        "timestamp",
+        "timestamps",
+        "timestampms",
+        "timestampus",
+        "timestampns",
+    }
+)
+# Without a header, a first column of integers that increase, by 1 on at least
+# this share of at least this many lines, looks like frame numbers.
+FRAME_LIKE_SHARE = 0.5
+MIN_FRAME_LIKE_LINES = 3
 
 
 # ----------------------------------------------------------------------------
@@ -207,47 +240,256 @@ def _detect_delimiter(line, delimiter):
     return None
 
 
-def _header_joints(tokens):
-    """``(has_frame_column, values_per_joint, joint names)`` from a header, or None.
+def _joint_names(layout):
+    """``{normalised name: name}`` of the joints a header may name, or {}."""
+    known = {_norm(n): n for n in layout.names or ()}
+    for n in layout.order or ():
+        known.setdefault(_norm(n), n)
+    return known
 
-    Only a header whose joint columns are named ``<joint>_x, <joint>_y,
-    <joint>_z`` (separator ``_``, ``.``, ``:``, ``/``, ``-``, blank or none;
-    optionally a 4th column per joint) gives joint names.
+
+def _classify(token, known):
+    """``(kind, joint, detail)`` of one header name.
+
+    ``kind`` is ``"frame"``, ``"time"``, ``"coord"`` (``joint`` and axis 0-2 in
+    ``detail``), ``"extra"`` (a value of ``joint`` that is not a coordinate,
+    such as ``Head_confidence``: the suffix in ``detail``), ``"empty"`` or
+    ``"unknown"``. ``joint`` is a normalised name of ``known``.
     """
-    for frame in (0, 1):
-        for per_joint in (3, 4):
-            body = tokens[frame:]
-            if not body or len(body) % per_joint:
-                continue
-            names = []
-            for k in range(0, len(body), per_joint):
-                parts = [_COORD_RE.match(t) for t in body[k : k + 3]]
-                if not all(parts):
-                    break
-                stems = {p.group(1) for p in parts}
-                axes = "".join(p.group(2).lower() for p in parts)
-                if len(stems) != 1 or axes != "xyz" or not parts[0].group(1):
-                    break
-                names.append(parts[0].group(1))
-            else:
-                return bool(frame), per_joint, names
-    return None
+    n = _norm(token)
+    if not n:
+        return "empty", None, None
+    if n in FRAME_NAMES:
+        return "frame", None, None
+    if n in TIME_NAMES:
+        return "time", None, None
+    match = _COORD_RE.match(token)
+    if match and match.group(1) and _norm(match.group(1)) in known:
+        return "coord", _norm(match.group(1)), "xyz".index(match.group(2).lower())
+    stems = [k for k in known if n.startswith(k) and len(n) > len(k)]
+    if stems:
+        joint = max(stems, key=len)
+        return "extra", joint, n[len(joint) :]
+    return "unknown", None, None
 
 
-def _names_joints(header_joints, layout):
-    """Whether header names are meant as joint names (any is a known joint)."""
-    if layout.names is None:
+def _axis_name(tokens, cols, axis):
+    """Name of the missing ``axis`` column, spelt like its joint's other columns."""
+    token = tokens[next(c for c in cols if c >= 0)]
+    match = _COORD_RE.match(token)
+    letters = "XYZ" if match.group(2).isupper() else "xyz"
+    return token[:-1] + letters[axis]
+
+
+def _listed(items, limit=8):
+    items = list(items)
+    return ", ".join(items[:limit]) + (", ..." if len(items) > limit else "")
+
+
+def _header_columns(tokens, layout, frame_column):
+    """``(coords, frame, time, problems)`` from a header naming joint columns.
+
+    None when no header name is a coordinate of a joint of ``layout`` (a
+    generic header such as ``j0_x, j0_y, ...``, read by position). ``coords``
+    is an ``(n_joints, 3)`` array of the column of each coordinate of each
+    joint of the layout (-1: the file lacks the joint); ``frame`` and ``time``
+    are columns or None; ``problems`` lists what is wrong with the header
+    (missing, duplicated, unknown columns), empty when it can be read.
+    """
+    known = _joint_names(layout)
+    kinds = [_classify(t, known) for t in tokens]
+    if not any(kind == "coord" for kind, _, _ in kinds):
+        return None
+    frames = [i for i, (kind, _, _) in enumerate(kinds) if kind == "frame"]
+    problems = []
+    if frame_column is True and not frames:
+        if kinds[0][0] == "coord":
+            problems.append(
+                f"frame_column=True, but the header names no frame column and its "
+                f"first column {tokens[0]!r} is a joint coordinate"
+            )
+        else:
+            kinds[0] = ("frame", None, None)
+            frames = [0]
+    elif frame_column is False and frames:
+        problems.append(
+            f"the header names a frame column {tokens[frames[0]]!r} (column "
+            f"{frames[0] + 1}), but frame_column=False"
+        )
+    where = {}  # (kind, joint, detail) -> columns
+    for i, key in enumerate(kinds):
+        where.setdefault(key, []).append(i)
+    for (kind, _, _), cols in where.items():
+        if len(cols) > 1 and kind not in ("unknown", "empty"):
+            problems.append(
+                f"column {tokens[cols[0]]!r} appears {len(cols)} times (columns "
+                f"{', '.join(str(c + 1) for c in cols)})"
+            )
+    coords_of = {}  # joint -> [column of x, y, z] (-1: missing)
+    for i, (kind, joint, axis) in enumerate(kinds):
+        if kind == "coord":
+            cols = coords_of.setdefault(joint, [-1, -1, -1])
+            if cols[axis] < 0:
+                cols[axis] = i
+    unknown = [i for i, (kind, _, _) in enumerate(kinds) if kind == "unknown"]
+    # A non-coordinate value of a joint (a confidence) is read, and ignored,
+    # when most joints of the file have one of that name; otherwise it is an
+    # unknown column (a misspelt coordinate such as ``Head_q``).
+    holders = {}
+    for kind, joint, suffix in kinds:
+        if kind == "extra" and joint in coords_of:
+            holders.setdefault(suffix, set()).add(joint)
+    for i, (kind, joint, suffix) in enumerate(kinds):
+        if kind == "extra" and (
+            joint not in coords_of or 2 * len(holders[suffix]) <= len(coords_of)
+        ):
+            unknown.append(i)
+    empty = [i for i, (kind, _, _) in enumerate(kinds) if kind == "empty"]
+    if empty:
+        problems.append(
+            f"column(s) {', '.join(str(i + 1) for i in empty)} of the header have "
+            f"no name"
+        )
+    layout_joints = {_norm(n): k for k, n in enumerate(layout.names)}
+    # names of `layout` (a list) that are not joints of the layout it matched
+    strange = [known[j] for j in coords_of if j not in layout_joints]
+    columns = []
+    for i in sorted(unknown):
+        match = _COORD_RE.match(tokens[i])
+        if kinds[i][0] == "unknown" and match and match.group(1):
+            strange.append(match.group(1))
+        else:
+            columns.append(repr(tokens[i]))
+    if strange:
+        problems.append(
+            f"joint(s) {_listed(dict.fromkeys(strange), 5)} are not in layout "
+            f"{layout.name!r} ({_listed(layout.names, 4)}); give the right `layout`"
+        )
+    if columns:
+        problems.append(
+            f"column(s) {_listed(columns)} name no coordinate of a joint of layout "
+            f"{layout.name!r} (<joint>_x, <joint>_y, <joint>_z), nor a frame or "
+            f"time column"
+        )
+    missing = [
+        _axis_name(tokens, cols, a)
+        for cols in coords_of.values()
+        for a in range(3)
+        if cols[a] < 0
+    ]
+    if missing:
+        problems.append(
+            f"the header has no column {_listed(missing)} (each joint it names "
+            f"needs its x, y and z columns)"
+        )
+    absent = _required(layout.adapter, layout.names) - set(coords_of)
+    if absent:
+        names = [n for n in layout.names if _norm(n) in absent]
+        problems.append(
+            f"layout {layout.name!r} needs joint(s) {_listed(names)}, which the file "
+            f"does not have"
+        )
+    if not problems and layout.order is not None:
+        order = [_norm(j) for j in layout.order]
+        if list(coords_of) != order:
+            named = [known[j] for j in coords_of]
+            problems.append(
+                f"the header names the joints {_listed(named, 4)} but `layout` "
+                f"lists {_listed(layout.order, 4)}"
+            )
+    coords = np.full((layout.n_joints, 3), -1, dtype=np.intp)
+    for joint, cols in coords_of.items():
+        if joint in layout_joints:
+            coords[layout_joints[joint]] = cols
+    times = [i for i, (kind, _, _) in enumerate(kinds) if kind == "time"]
+    frame = frames[0] if frames and frame_column is not False else None
+    return coords, frame, times[0] if times else None, problems
+
+
+def _positional_columns(n_columns, layout, name, line, frame_column, lead):
+    """``(coords, frame, time, per_joint)`` of a file read by position.
+
+    The joints are in the order of ``layout`` after an optional first column
+    (the frame number, or a timestamp when ``lead`` is ``"time"``); a header,
+    if any, names no joint of the layout (``lead``: what its first name says
+    the first column is, or None). Raises when the number of values fits no
+    reading, or more than one.
+    """
+    take = layout.take(layout.order, name)
+    n_file = layout.n_joints if layout.order is None else len(layout.order)
+    if frame_column is None:
+        firsts = (0, 1) if lead is None else (1,)
+    else:
+        firsts = (int(frame_column),)
+    options = [
+        (first, per_joint)
+        for first in firsts
+        for per_joint in (3, 4)
+        if first + per_joint * n_file == n_columns
+    ]
+    if not options:
+        if frame_column is None and lead is not None:
+            frame_part = f" + 1 (the header names a {lead} column first)"
+        else:
+            frame_part = {
+                None: " (+1 with a frame number first)",
+                True: " + 1",
+                False: "",
+            }[frame_column]
+        raise _format_error(
+            name,
+            line,
+            f"expected {3 * n_file} or {4 * n_file} values{frame_part} per line for "
+            f"{n_file} joints of layout {layout.name!r} (x, y, z and an optional 4th "
+            f"value per joint), got {n_columns}",
+        )
+    if len(options) > 1:
+        readings = " or ".join(
+            f"{'a frame number and ' if first else ''}{per_joint} values per joint"
+            for first, per_joint in options
+        )
+        raise _format_error(
+            name,
+            line,
+            f"{n_columns} values per line fit {readings} for the {n_file} joint(s) of "
+            f"layout {layout.name!r}; say which with frame_column=True or False, or "
+            f"add a header naming the columns",
+        )
+    first, per_joint = options[0]
+    coords = np.full((layout.n_joints, 3), -1, dtype=np.intp)
+    present = take >= 0
+    coords[present] = first + per_joint * take[present, None] + np.arange(N_COORDS)
+    is_time = first and lead == "time" and frame_column is None
+    frame = 0 if first and not is_time else None
+    return coords, frame, 0 if is_time else None, per_joint
+
+
+def _looks_like_frame_numbers(column):
+    """Whether a column holds increasing integers, mostly one apart."""
+    if len(column) < MIN_FRAME_LIKE_LINES or not np.isfinite(column).all():
         return False
-    known = {_norm(n) for n in layout.names}
-    if layout.order is not None:
-        known |= {_norm(n) for n in layout.order}
-    return any(_norm(j) in known for j in header_joints)
+    steps = np.diff(column)
+    return bool(
+        np.all(column == np.round(column))
+        and np.all(steps > 0)
+        and np.mean(steps == 1) >= FRAME_LIKE_SHARE
+    )
 
 
-def _read_skeleton(path, layout, *, delimiter, header, frame_column):
-    """``(X, frame_numbers or None)`` of one skeleton file (see read_skeleton_csv)."""
-    name = path.name
-    lines = _lines(_read_text(path))
+def _drop_trailing_empty(line, sep):
+    """``line`` without the separator that ends it (an empty last value)."""
+    text = line.rstrip(" \r")
+    return text[: -len(sep)] if text.endswith(sep) else line
+
+
+def _read_skeleton(path, layout, *, delimiter, header, frame_column, name=None):
+    """``(X, frame_numbers or None)`` of one skeleton file (see read_skeleton_csv).
+
+    ``name`` names the file in messages (default: its base name).
+    """
+    name = path.name if name is None else name
+    frame_column = None if frame_column is None else bool(frame_column)
+    lines = _lines(_read_text(path, name=name))
     if not lines:
         raise DataFormatError(
             f"{name} is empty: expected one line of joint positions per frame",
@@ -262,62 +504,40 @@ def _read_skeleton(path, layout, *, delimiter, header, frame_column):
     first = 2 if has_header else 1
     if not body:
         raise DataFormatError(f"{name} has a header but no frame line", file=name)
-    n_columns = len(_split(body[0], sep))
-    file_joints = fixed = None
+    if has_header and sep is not None and len(tokens) > 1 and not tokens[-1]:
+        # A trailing separator on every line (spreadsheet exports): no column.
+        tokens = tokens[:-1]
+        body = [_drop_trailing_empty(ln, sep) for ln in body]
+    # A header names the columns: every line must have a value for each.
+    n_columns = len(tokens) if has_header else len(_split(body[0], sep))
+    found = lead = None
     if has_header:
-        if len(tokens) != n_columns:
-            raise _format_error(
-                name,
-                1,
-                f"the header has {len(tokens)} columns but line 2 has {n_columns} "
-                f"values",
-            )
-        found = _header_joints(tokens)
-        if found is not None and not _names_joints(found[2], layout):
-            found = None  # generic column names (``j0_x``...): not joint names
-        if found is not None:
-            frame, per_joint, file_joints = found
-            if layout.order is not None and [_norm(j) for j in file_joints] != [
-                _norm(j) for j in layout.order
-            ]:
-                raise _format_error(
-                    name,
-                    1,
-                    f"the header names the joints {', '.join(file_joints[:4])}, ... "
-                    f"but `layout` lists {', '.join(layout.order[:4])}, ...",
-                )
-            if frame_column is None or bool(frame_column) == frame:
-                fixed = (frame, per_joint)
-    if file_joints is None and layout.order is not None:
-        file_joints = layout.order
-    take = layout.take(file_joints, name)
-    n_file = layout.n_joints if file_joints is None else len(file_joints)
-    if fixed is None:
-        options = [
-            (frame, per_joint)
-            for frame in ((0, 1) if frame_column is None else (int(frame_column),))
-            for per_joint in (3, 4)
-            if frame + per_joint * n_file == n_columns
-        ]
-        if not options:
-            frame_part = {None: " (+1 with a frame number first)", True: " + 1"}
-            raise _format_error(
-                name,
-                first,
-                f"expected {3 * n_file} or {4 * n_file} values"
-                f"{frame_part.get(frame_column, '')} per line for {n_file} joints of "
-                f"layout {layout.name!r} (x, y, z and an optional 4th value per "
-                f"joint), got {n_columns}",
-            )
-        fixed = options[0]
-    frame, per_joint = fixed
+        found = _header_columns(tokens, layout, frame_column)
+        if found is not None and found[3]:
+            raise _format_error(name, 1, "; ".join(found[3]))
+        first_name = _norm(tokens[0])
+        lead = (
+            "frame"
+            if first_name in FRAME_NAMES
+            else "time"
+            if first_name in TIME_NAMES
+            else None
+        )
+    check_first = False
+    if found is None:
+        coords, frame, time, per_joint = _positional_columns(
+            n_columns, layout, name, first, frame_column, lead
+        )
+        check_first = frame_column is None and lead is None and frame is None
+    else:
+        coords, frame, time, _ = found
     values = _parse_table(
         body, n_columns, name, sep=sep, first_line=first, allow_nan=True
     )
     frame_numbers = None
-    if frame:
+    if frame is not None:
         frame_numbers = _integer_column(
-            values[:, 0], name, first_line=first, what="frame number"
+            values[:, frame], name, first_line=first, what="frame number"
         )
         back = np.flatnonzero(np.diff(frame_numbers) <= 0)
         if back.size:
@@ -328,20 +548,36 @@ def _read_skeleton(path, layout, *, delimiter, header, frame_column):
                 f"frame number {frame_numbers[i]} does not follow "
                 f"{frame_numbers[i - 1]} (frame numbers must increase)",
             )
-    raw = values[:, frame:]
+    if time is not None:
+        _check_times(values[:, time], name, first)
+    if check_first and _looks_like_frame_numbers(values[:, 0]):
+        n_file = layout.n_joints if layout.order is None else len(layout.order)
+        shown = ", ".join(f"{v:g}" for v in values[:3, 0])
+        raise _format_error(
+            name,
+            None,
+            f"the first value of every line looks like a frame number ({shown}, "
+            f"...), but {n_columns} values per line fit layout {layout.name!r} only "
+            f"without a frame number ({n_file} joints x {per_joint} values): with "
+            f"one, a value is missing from every line. Pass frame_column=False if "
+            f"the first value is a coordinate; otherwise add the missing column, or "
+            f"a header naming the columns",
+        )
+    special = [c for c in (frame, time) if c is not None]
+    data = np.setdiff1d(np.arange(n_columns), special)
+    raw = values[:, data]
     big = np.abs(raw) > MAX_ABS_RAW_VALUE
     if big.any():
         i, j = np.argwhere(big)[0]
         raise _format_error(
             name,
             int(i) + first,
-            f"value {j + frame + 1} ({raw[i, j]:g}) is beyond +-{MAX_ABS_RAW_VALUE:g} "
+            f"value {data[j] + 1} ({raw[i, j]:g}) is beyond +-{MAX_ABS_RAW_VALUE:g} "
             f"in any unit; the file is corrupt",
         )
-    coords = raw.reshape(len(raw), n_file, per_joint)[..., :N_COORDS]
-    frames = np.zeros((len(raw), layout.n_joints, N_COORDS))
-    present = take >= 0
-    frames[:, present] = coords[:, take[present]]
+    frames = np.zeros((len(values), layout.n_joints, N_COORDS))
+    present = coords[:, 0] >= 0
+    frames[:, present] = values[:, coords[present]]
     with np.errstate(all="ignore"):
         X = layout.adapter(frames)
     bad = ~np.isfinite(X) | (np.abs(X) > MAX_ABS_COORDINATE)
@@ -363,6 +599,25 @@ def _read_skeleton(path, layout, *, delimiter, header, frame_column):
                 f"divide by 1000, or use an adapter with the right units)"
             )
     return np.ascontiguousarray(X), frame_numbers
+
+
+def _check_times(column, name, first):
+    """Raise unless a timestamp column is finite and never decreases."""
+    bad = np.flatnonzero(~np.isfinite(column))
+    if bad.size:
+        i = int(bad[0])
+        raise _format_error(
+            name, i + first, f"timestamp {column[i]:g} is not a finite number"
+        )
+    back = np.flatnonzero(np.diff(column) < 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise _format_error(
+            name,
+            i + first,
+            f"timestamp {column[i]:g} is before {column[i - 1]:g} (timestamps must "
+            f"not decrease)",
+        )
 
 
 def _check_reader_options(delimiter, header, frame_column):
@@ -424,14 +679,30 @@ def read_skeleton_csv(
         first line: tab, else semicolon, else comma, else blanks.
     header : bool or None, default=None
         Whether the first line is a header. None: it is one when none of its
-        values is a number. A header naming the joint columns ``<joint>_x,
-        <joint>_y, <joint>_z`` sets the joint order (checked against
-        ``layout``); any other header is skipped.
+        values is a number. A header that names joint columns
+        ``<joint>_x, <joint>_y, <joint>_z`` (``.``, ``:``, ``-``, a blank or
+        nothing may replace ``_``; any case) with joint names of ``layout``
+        decides the columns by name, in any order: a column ``frame`` (or
+        ``frame_number``, ``frame_id``, ...) holds the frame numbers, a column
+        ``time`` or ``timestamp`` is checked (finite, never decreasing) and
+        ignored, a column ``<joint>_<name>`` that most joints have (such as
+        ``Head_confidence``) is ignored, and a missing, duplicated, unnamed or
+        unknown column is an error naming it. A header that names no joint
+        of ``layout`` (``j0_x, j0_y, ...``) is skipped and the values are read
+        by position. A header that ends with an empty name (a trailing
+        separator) has no column there.
     frame_column : bool or None, default=None
-        Whether the first value of a line is the frame number. None decides
-        from the number of values (``3 * n_joints + 1`` or ``4 * n_joints + 1``
-        means a frame number). Frame numbers must be increasing integers; they
-        are returned, not used to place the rows.
+        Whether the file has a frame-number column. None decides: from a
+        header naming the columns, by the name ``frame``; otherwise from the
+        number of values (``3 * n_joints + 1`` or ``4 * n_joints + 1`` means a
+        frame number first). It is an error when the number of values fits
+        both readings, or when the first value of every line looks like a
+        frame number (integers increasing mostly by 1) but the number of
+        values fits only the reading without one (a column is missing, or
+        the first value is a coordinate): say which with True or False. True:
+        the column named ``frame``, else the first column, holds the frame
+        numbers; False: no column does. Frame numbers must be increasing
+        integers; they are returned, not used to place the rows.
     return_frame_numbers : bool, default=False
         Also return the frame numbers (None without a frame column).
 
@@ -448,8 +719,9 @@ def read_skeleton_csv(
     DataFormatError
         Naming the file and 1-based line: a wrong number of values, a value
         that is not a number, an infinite value, a frame number that is not an
-        increasing integer, a position out of range, a header whose joints do
-        not fit ``layout``.
+        increasing integer, a position out of range; a header with a missing,
+        duplicated or unknown column (naming it) or whose joints do not fit
+        ``layout``; values whose layout is ambiguous (see ``frame_column``).
 
     Warns
     -----
