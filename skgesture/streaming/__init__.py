@@ -9,8 +9,9 @@
   commands.
 * Adapters map Kinect v2, Azure Kinect, MediaPipe Pose and MSR Action3D
   skeletons to the Kinect v1 layout of the models; :class:`SkeletonSource`
-  is the interface of a live source and :class:`ReplaySource` replays a
-  recording.
+  is the interface of a source, :class:`ReplaySource` replays a recording,
+  and :class:`UDPSource` (JSON datagrams), :class:`StdinSource` (CSV rows)
+  and :class:`LSLSource` (Lab Streaming Layer) read a live stream.
 
 See ``docs/streaming.md`` for the timing and the differences from offline
 ``predict``.
@@ -39,12 +40,17 @@ from skgesture.streaming._adapters import (
     KinectV2Adapter,
     MediaPipePoseAdapter,
     MSRAction3DAdapter,
-    ReplaySource,
     SkeletonAdapter,
-    SkeletonSource,
     get_adapter,
 )
 from skgesture.streaming._recognizer import GestureEvent, StreamingRecognizer
+from skgesture.streaming._sources import (
+    LSLSource,
+    ReplaySource,
+    SkeletonSource,
+    StdinSource,
+    UDPSource,
+)
 
 __all__ = [
     "AZURE_KINECT_JOINTS",
@@ -58,6 +64,7 @@ __all__ = [
     "GestureEvent",
     "KinectV1Adapter",
     "KinectV2Adapter",
+    "LSLSource",
     "MSRAction3DAdapter",
     "MediaPipePoseAdapter",
     "PickAndPlaceRobot",
@@ -67,6 +74,8 @@ __all__ = [
     "SimulatedRobot",
     "SkeletonAdapter",
     "SkeletonSource",
+    "StdinSource",
     "StreamingRecognizer",
+    "UDPSource",
     "get_adapter",
 ]

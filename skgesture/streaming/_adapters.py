@@ -1,4 +1,4 @@
-"""Skeleton adapters (other layouts -> Kinect v1) and skeleton sources.
+"""Skeleton adapters: other layouts -> Kinect v1.
 
 Every model of skgesture works on the 20-joint Kinect v1 (NUI) layout, in
 metres, camera space (x towards the sensor's left, y up, z away from the
@@ -11,16 +11,14 @@ An adapter maps the frames of another sensor onto it:
 
 Adapters work on one frame ``(J, C)`` or a sequence ``(T, J, C)``; untracked
 frames (all zeros or holding a NaN) map to all-zero frames, which every
-skgesture stage treats as untracked. A :class:`SkeletonSource` yields frames
-(adapted) for :class:`~skgesture.streaming.StreamingRecognizer`;
-:class:`ReplaySource` replays a recording.
+skgesture stage treats as untracked. The sources that yield adapted frames
+(:class:`SkeletonSource`, :class:`ReplaySource` and the live ones) are in
+``skgesture/streaming/_sources.py``.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-import time
 from abc import ABC, abstractmethod
-from numbers import Real
 
 import numpy as np
 
@@ -44,8 +42,6 @@ __all__ = [
     "MediaPipePoseAdapter",
     "MSRAction3DAdapter",
     "get_adapter",
-    "SkeletonSource",
-    "ReplaySource",
 ]
 
 
@@ -453,117 +449,3 @@ def get_adapter(name, **params):
             f"unknown layout {name!r}; known: {', '.join(sorted(_ADAPTERS))}"
         )
     return cls(**params)
-
-
-class SkeletonSource(ABC):
-    """A source of Kinect v1 frames for :class:`StreamingRecognizer`.
-
-    Implement :meth:`frames` to yield one ``(20, 3)`` array (metres, Kinect v1
-    order; all zeros when nobody is tracked) per sensor frame. A live source
-    wraps a sensor SDK: read its joints, pass them through the matching
-    :class:`SkeletonAdapter`, yield. Iterating the source iterates
-    :meth:`frames`.
-
-    Attributes
-    ----------
-    fps : float
-        Nominal frame rate.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skgesture.streaming import SkeletonSource
-    >>> class StillSource(SkeletonSource):
-    ...     fps = 20.0
-    ...     def frames(self):
-    ...         for _ in range(3):
-    ...             yield np.ones((20, 3))
-    >>> [f.shape for f in StillSource()]
-    [(20, 3), (20, 3), (20, 3)]
-    """
-
-    fps = 20.0
-
-    @abstractmethod
-    def frames(self):
-        """Yield Kinect v1 frames of shape ``(20, 3)``."""
-
-    def __iter__(self):
-        return iter(self.frames())
-
-
-class ReplaySource(SkeletonSource):
-    """Replays a recorded sequence frame by frame, optionally in real time.
-
-    Parameters
-    ----------
-    X : array-like of shape (n_frames, n_joints, 3)
-        The recording, in the layout of ``adapter``.
-    adapter : SkeletonAdapter, str or None, default=None
-        Maps the frames to Kinect v1 (an adapter, or a layout name for
-        :func:`get_adapter`); None when ``X`` is already Kinect v1.
-    fps : float, default=20.0
-        Frame rate of the recording.
-    realtime : bool, default=False
-        Wait between frames so that they come at ``fps``.
-    clock : callable, default=time.monotonic
-        Clock used with ``realtime`` (seconds).
-    sleep : callable, default=time.sleep
-        Sleep function used with ``realtime``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skgesture.streaming import ReplaySource
-    >>> X = np.zeros((4, 25, 3)); X[:, 0] = [0.1, 0.0, 2.0]
-    >>> frames = list(ReplaySource(X, adapter="kinect_v2"))
-    >>> len(frames), frames[0].shape, frames[0][0].tolist()
-    (4, (20, 3), [0.1, 0.0, 2.0])
-    """
-
-    def __init__(
-        self,
-        X,
-        *,
-        adapter=None,
-        fps=20.0,
-        realtime=False,
-        clock=time.monotonic,
-        sleep=time.sleep,
-    ):
-        if isinstance(adapter, str):
-            adapter = get_adapter(adapter)
-        if adapter is not None and not isinstance(adapter, SkeletonAdapter):
-            raise TypeError(
-                "adapter must be a SkeletonAdapter, a layout name (see get_adapter) "
-                f"or None, got {type(adapter).__name__}"
-            )
-        self.adapter = adapter or KinectV1Adapter()
-        self.X = _as_positions(X, "ReplaySource X")
-        if self.X.ndim != 3:
-            raise ValueError(
-                f"X must have shape (n_frames, n_joints, 3), got {self.X.shape}"
-            )
-        if isinstance(fps, bool) or not isinstance(fps, Real) or not 0 < fps < np.inf:
-            raise ValueError(f"fps must be a positive finite number, got {fps!r}")
-        self.fps = float(fps)
-        self.realtime = realtime
-        self.clock = clock
-        self.sleep = sleep
-
-    def frames(self):
-        """Yield the adapted frames, paced at ``fps`` when ``realtime``.
-
-        Yields
-        ------
-        ndarray of shape (20, 3)
-            The next frame.
-        """
-        adapted = self.adapter(self.X)
-        start = self.clock()
-        for i, frame in enumerate(adapted):
-            if self.realtime:
-                wait = start + i / self.fps - self.clock()
-                if wait > 0:
-                    self.sleep(wait)
-            yield frame
