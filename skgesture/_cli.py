@@ -8,8 +8,12 @@ scores from :mod:`skgesture.metrics` and figures from :mod:`skgesture.plotting`.
 
 A user mistake (a missing folder, a file that is not a model, an unknown
 method, a model from another version, bad data) ends with one line on stderr
-and exit status 1; ``--traceback`` shows the full traceback instead. Progress
-bars go to stderr, results to stdout.
+and exit status 1; a wrong option ends with the subcommand's usage and one
+line (the closest option suggested) and status 2; ``--traceback`` shows the
+full traceback instead. An error that is no user mistake (a bug) shows its
+traceback. Progress bars go to stderr (plain lines when stderr is not a
+terminal), results to stdout; a reader that goes away early (``| head``)
+ends the program quietly with status 141.
 
 This module holds the argument parser, :func:`main` and its error reporting;
 the subcommands are in :mod:`skgesture._cli_commands`, and what they share
@@ -21,9 +25,13 @@ the subcommands are in :mod:`skgesture._cli_commands`, and what they share
 
 import argparse
 import contextlib
+import difflib
+import linecache
+import os
 import re
 import sys
 import warnings
+from pathlib import Path
 
 from skgesture._cli_commands import (
     cmd_demo,
@@ -33,12 +41,17 @@ from skgesture._cli_commands import (
     cmd_stream,
     cmd_train,
 )
-from skgesture._cli_support import UsageError
+from skgesture._cli_support import UsageError, plain_progress
 from skgesture._version import __version__
 
 __all__ = ["main"]
 
 METHODS = ("recommended", "A", "B", "C", "C-paper")
+DEFAULT_METHOD = "recommended"  # make_recommended, as README and docs/choosing.md
+JOINTS = ("auto", "paper11", "full20")
+EXIT_ERROR = 1
+EXIT_USAGE = 2
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell shows for `yes | head -1`
 PLOTS = ("timeline", "segmentation", "confusion", "skeleton")
 DEFAULT_MAX_TIMELINES = 12  # sequences drawn by `plot timeline`
 
@@ -54,6 +67,73 @@ def _one_line(exc):
         text = str(exc) or type(exc).__name__
     text = re.sub(r"^\[Errno \d+\]\s*", "", text)
     return " ".join(text.split())
+
+
+# Packages whose deliberate ``raise TypeError(...)`` is input validation: a
+# TypeError raised there by a ``raise`` statement is a user mistake, any other
+# TypeError (one Python raises inside an expression) a bug.
+_VALIDATING_PACKAGES = ("skgesture", "sklearn")
+
+
+def _package_dirs():
+    dirs = []
+    for name in _VALIDATING_PACKAGES:
+        module = sys.modules.get(name)
+        if getattr(module, "__file__", None):
+            dirs.append(Path(module.__file__).resolve().parent)
+    return dirs
+
+
+def _raised_by_validation(exc):
+    """Whether ``exc`` comes from a ``raise`` statement of skgesture or sklearn."""
+    tb = exc.__traceback__
+    if tb is None:
+        return False
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    filename = tb.tb_frame.f_code.co_filename
+    try:
+        path = Path(filename).resolve()
+    except (OSError, ValueError):
+        return False
+    if not any(d in path.parents for d in _package_dirs()):
+        return False
+    return linecache.getline(filename, tb.tb_lineno).lstrip().startswith("raise ")
+
+
+def _library_error_types():
+    """The error classes of skgesture that are user mistakes, where loaded.
+
+    Both are ValueErrors today; naming them keeps them one-line errors
+    whatever their bases become. Looked up in ``sys.modules``: an error of a
+    module that was never imported cannot have been raised.
+    """
+    found = []
+    for module, name in (
+        ("skgesture._persistence", "ModelFileError"),
+        ("skgesture.datasets._base", "DataFormatError"),
+    ):
+        cls = getattr(sys.modules.get(module), name, None)
+        if isinstance(cls, type) and issubclass(cls, Exception):
+            found.append(cls)
+    return tuple(found)
+
+
+def _is_user_error(exc):
+    """Whether ``exc`` is a mistake of the user (one line) rather than a bug.
+
+    A :class:`~skgesture._cli_support.UsageError`, an ``OSError`` (a missing
+    or unreadable file), a ``ValueError`` (bad data, a damaged or foreign
+    model file: ``ModelFileError``, ``DataFormatError``), an ``ImportError``
+    (a missing optional dependency), and a ``TypeError`` raised on purpose by
+    the input validation of skgesture or scikit-learn (a model file holding
+    something that cannot stream, say). Any other exception is a bug.
+    """
+    if isinstance(exc, (UsageError, OSError, ValueError, ImportError)):
+        return True
+    if isinstance(exc, _library_error_types()):
+        return True
+    return isinstance(exc, TypeError) and _raised_by_validation(exc)
 
 
 @contextlib.contextmanager
@@ -157,16 +237,19 @@ def _add_method(parser):
     parser.add_argument(
         "--method",
         choices=METHODS,
-        default="B",
-        help="recommended (the toolkit's recommended tagger), A, B (the paper's "
-        "multi-scale methods), C (BiLSTM tagger, CPU size) or C-paper (the "
-        "paper's network); default B",
+        default=DEFAULT_METHOD,
+        help="recommended (the toolkit's recommended model, make_recommended; "
+        "the default), A, B (the paper's multi-scale methods), C (BiLSTM "
+        "tagger, CPU size) or C-paper (the paper's network)",
     )
     parser.add_argument(
         "--joints",
-        choices=("paper11", "full20"),
-        default="paper11",
-        help="descriptor joints (default paper11, the paper's upper body)",
+        choices=JOINTS,
+        default="auto",
+        help="joints the model reads: full20 (all 20 Kinect joints), paper11 "
+        "(the paper's 11 upper-body joints) or auto (the default): full20 "
+        "when the data track all 20 joints, as every loader gives them, "
+        "paper11 when they track only the upper body",
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument(
@@ -182,10 +265,21 @@ def _add_method(parser):
     )
 
 
+def _subcommand(sub, name, help):
+    """A subparser; like every parser here it takes no abbreviated options."""
+    return sub.add_parser(name, help=help, description=help, allow_abbrev=False)
+
+
 def build_parser():
-    """The argument parser of ``skgesture``."""
+    """The argument parser of ``skgesture``.
+
+    Options must be spelt out (``allow_abbrev=False`` on every parser):
+    ``--data 3`` is an unknown option, not ``--data-seed 3``. The parser's
+    ``commands`` attribute maps each subcommand to its parser.
+    """
     parser = argparse.ArgumentParser(
         prog="skgesture",
+        allow_abbrev=False,
         description="Find and name dynamic gestures in skeleton streams: train a "
         "model, score it, write predictions, draw figures, replay a stream.",
         epilog="Example: skgesture train precog --subjects 1-6 -o model.skg && "
@@ -202,7 +296,7 @@ def build_parser():
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("train", help="train a model and write the model file")
+    p = _subcommand(sub, "train", "train a model and write the model file")
     _add_data(p)
     _add_method(p)
     p.add_argument(
@@ -212,8 +306,8 @@ def build_parser():
     _add_common(p)
     p.set_defaults(func=cmd_train)
 
-    p = sub.add_parser(
-        "evaluate", help="score a model: Jaccard indices, accuracy, F1@k, per class"
+    p = _subcommand(
+        sub, "evaluate", "score a model: Jaccard indices, accuracy, F1@k, per class"
     )
     _add_data(p, with_model=True)
     _add_model_loading(p)
@@ -221,8 +315,8 @@ def build_parser():
     _add_common(p)
     p.set_defaults(func=cmd_evaluate)
 
-    p = sub.add_parser(
-        "predict", help="write prediction files (ChaLearn CSVs or intervals)"
+    p = _subcommand(
+        sub, "predict", "write prediction files (ChaLearn CSVs or intervals)"
     )
     _add_data(p, with_model=True)
     _add_model_loading(p)
@@ -241,7 +335,7 @@ def build_parser():
     _add_common(p)
     p.set_defaults(func=cmd_predict)
 
-    p = sub.add_parser("plot", help="draw a figure to PNG, SVG or PDF")
+    p = _subcommand(sub, "plot", "draw a figure to PNG, SVG or PDF")
     p.add_argument(
         "kind",
         choices=PLOTS,
@@ -274,8 +368,8 @@ def build_parser():
     _add_common(p)
     p.set_defaults(func=cmd_plot)
 
-    p = sub.add_parser(
-        "stream", help="replay a recording frame by frame and print the events"
+    p = _subcommand(
+        sub, "stream", "replay a recording frame by frame and print the events"
     )
     _add_data(p, with_model=True)
     _add_model_loading(p)
@@ -303,14 +397,35 @@ def build_parser():
     _add_common(p)
     p.set_defaults(func=cmd_stream)
 
-    p = sub.add_parser(
-        "demo", help="train on PRECOG subjects 1-6 and report on subjects 7-8"
+    p = _subcommand(
+        sub, "demo", "train on PRECOG subjects 1-6 and report on subjects 7-8"
     )
     _add_method(p)
     p.add_argument("-o", "--output", help="also write the model file")
     _add_common(p)
     p.set_defaults(func=cmd_demo)
+    parser.commands = dict(sub.choices)
     return parser
+
+
+def _option_strings(parser):
+    return [opt for action in parser._actions for opt in action.option_strings]
+
+
+def _reject_unknown(parser, args, extras):
+    """Exit (status 2) for the arguments that no parser took.
+
+    Reported under the usage of the subcommand they were given to, with the
+    closest option of that subcommand where one is close.
+    """
+    owner = parser.commands.get(getattr(args, "command", None), parser)
+    unknown = [a for a in extras if a.startswith("-") and a != "-"]
+    if not unknown:
+        owner.error(f"unrecognized arguments: {' '.join(extras)}")
+    given = unknown[0].split("=", 1)[0]
+    close = difflib.get_close_matches(given, _option_strings(owner), n=1)
+    hint = f"; did you mean {close[0]}?" if close else ""
+    owner.error(f"unknown option {given}{hint}")
 
 
 def main(argv=None):
@@ -324,7 +439,10 @@ def main(argv=None):
     Returns
     -------
     int
-        The exit status: 0 on success, 1 for an error, 2 for a usage error.
+        The exit status: 0 on success, 1 for an error, 2 for a usage error,
+        130 on Ctrl-C and 141 when the reader of the output went away early
+        (``skgesture evaluate ... | head -1``), as for a program that
+        SIGPIPE ends.
 
     Examples
     --------
@@ -333,23 +451,64 @@ def main(argv=None):
     skgesture ...
     0
     """
+    try:
+        status = _run(argv)
+        sys.stdout.flush()  # a broken pipe shows here, not at interpreter exit
+    except BrokenPipeError:
+        _discard_output()
+        return EXIT_BROKEN_PIPE
+    return status
+
+
+def _discard_output():
+    """Point stdout, and stderr where it is broken too, at the null device.
+
+    After a broken pipe the interpreter would report the failed flush of the
+    buffered output at exit; flushing into the null device ends quietly.
+    """
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        if name == "stderr":
+            try:
+                stream.flush()
+                continue  # stderr still reaches its reader
+            except BrokenPipeError:
+                pass
+            except (AttributeError, OSError, ValueError):
+                continue
+        try:
+            fd = stream.fileno()
+        except (AttributeError, OSError, ValueError):
+            continue  # not a real file (captured output): nothing is flushed at exit
+        null = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(null, fd)
+        finally:
+            os.close(null)
+
+
+def _run(argv):
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extras = parser.parse_known_args(argv)
+        if extras:
+            _reject_unknown(parser, args, extras)
     except SystemExit as exc:  # --help, --version, or a usage error
-        return exc.code if isinstance(exc.code, int) else 2
+        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
     if args.command is None:
         parser.print_usage(sys.stderr)
         print("skgesture: error: give a command, e.g. skgesture demo", file=sys.stderr)
-        return 2
-    with _warnings_as_lines():
+        return EXIT_USAGE
+    with _warnings_as_lines(), plain_progress(args):
         try:
             return args.func(args) or 0
         except KeyboardInterrupt:
             print("skgesture: interrupted", file=sys.stderr)
             return 130
-        except (UsageError, OSError, ValueError, ImportError) as exc:
-            if args.traceback:
+        except BrokenPipeError:
+            raise
+        except Exception as exc:
+            if args.traceback or not _is_user_error(exc):
                 raise
             print(f"skgesture {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-            return 1
+            return EXIT_ERROR

@@ -15,9 +15,12 @@ import numpy as np
 
 from skgesture._cli_support import (
     UsageError,
+    _check_device,
     _class_name,
     _fps,
     _info,
+    _joints,
+    _live_bars,
     _load_data,
     _load_model,
     _loader_verbose,
@@ -55,19 +58,22 @@ def cmd_train(args):
     output = Path(args.output).expanduser()
     if output.exists() and not args.overwrite:
         raise UsageError(f"{output} exists; pass --overwrite to replace it")
+    _check_device(args.device)
     data, kind, name = _load_data(args, need_labels=True)
     verbose = 0 if args.quiet else 1
-    pipe = _make_model(args, verbose)
+    joints = _joints(args, data)
+    pipe = _make_model(args, verbose, joints)
     _info(
         args,
-        f"training method {args.method} on {name}: {len(data.X)} sequences, "
-        f"{_n_frames(data):,} frames",
+        f"training method {args.method} (joints {joints}) on {name}: "
+        f"{len(data.X)} sequences, {_n_frames(data):,} frames",
     )
     start = time.perf_counter()
     pipe.fit(data.X, data.y)
     seconds = time.perf_counter() - start
     metadata = {
         "method": args.method,
+        "joints": joints,
         "data": args.data,
         "data_kind": kind,
         "subjects": args.subjects,
@@ -87,7 +93,7 @@ def cmd_evaluate(args):
     data, kind, name = _load_data(args, need_labels=True)
     model, info = _load_model(args, data)
     names = _target_names(data, info)
-    y_pred = _predict(args, model, data.X)
+    y_pred = _predict(args, model, data.X, data.get("sample_ids"))
     scores = _scores(data, kind, y_pred, names)
     meta = info.get("metadata") or {}
     if args.json:
@@ -135,7 +141,7 @@ def cmd_predict(args):
     if existing and not args.overwrite:
         more = f" (and {len(existing) - 1} more)" if len(existing) > 1 else ""
         raise UsageError(f"{existing[0]} exists{more}; pass --overwrite to replace")
-    y_pred = _predict(args, model, data.X)
+    y_pred = _predict(args, model, data.X, data.get("sample_ids"))
     out.mkdir(parents=True, exist_ok=True)
     if fmt == "chalearn":
         from skgesture.datasets import write_chalearn_predictions
@@ -268,6 +274,37 @@ def _robot_mapping(args, recognizer):
     return dict(zip(classes, commands))
 
 
+def _delay_bound(recognizer, fps):
+    """``(frames, text)``: the most frames an event comes after its gesture's end.
+
+    ``recognizer.max_delay`` (the sum of the stages' look-aheads) bounds every
+    event but one case: with Methods A/B nothing in an activity period is
+    emitted before the period is known to be long (``short_length`` frames),
+    so a gesture ending in its first ``short_length`` frames waits until the
+    classifier has seen frame ``start + short_length - 1``, that is up to
+    ``lookahead + short_length - 1`` frames after its end (docs/streaming.md,
+    "Delay"; :class:`~skgesture.streaming.StreamingRecognizer`, Notes).
+    """
+    bound = int(recognizer.max_delay)
+    text = (
+        f"events come at most {bound} frames ({bound / fps:.2f} s) after a gesture ends"
+    )
+    last = recognizer.pipeline.steps[-1][1]
+    short = getattr(last, "short_length", None)
+    if short is None or recognizer.early_decision:
+        return bound, text
+    wait = int(recognizer.lookahead) + int(short) - 1
+    if wait <= bound:
+        return bound, text
+    text = (
+        f"events come at most {wait} frames ({wait / fps:.2f} s) after a gesture "
+        f"ends: at most {bound} ({bound / fps:.2f} s), but a gesture that ends in "
+        f"the first {short} frames of a longer activity period waits until the "
+        f'period is known to be long (docs/streaming.md, "Delay")'
+    )
+    return wait, text
+
+
 def cmd_stream(args):
     from skgesture.streaming import StreamingRecognizer
 
@@ -293,16 +330,15 @@ def cmd_stream(args):
         for cls, command in mapping.items():
             _info(args, f"  gesture {_class_name(cls, names)} -> {command}")
     print(
-        f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at "
-        f"{fps:g} fps (events come at most {recognizer.max_delay} frames after "
-        f"a gesture ends)"
+        f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at {fps:g} fps"
     )
+    print(_delay_bound(recognizer, fps)[1])
     bar = _progress(args, range(len(stream)), "frames", unit="frame")
     write = print
-    if not args.quiet:
+    if not args.quiet and _live_bars():
         from tqdm.auto import tqdm
 
-        write = tqdm.write
+        write = tqdm.write  # the events above the bar
     delays = []
 
     def report(events, pairs):
@@ -357,6 +393,7 @@ def cmd_demo(args):
     """Summarise PRECOG, train on subjects 1-6, report on subjects 7-8."""
     from skgesture.datasets import load_precog
 
+    _check_device(args.device)
     data = load_precog(verbose=_loader_verbose(args))
     segments = np.concatenate(data.segments)
     lengths = segments[:, 2] - segments[:, 1]
@@ -368,8 +405,13 @@ def cmd_demo(args):
     )
     train = _select_subjects(data, DEMO_TRAIN_SUBJECTS, "PRECOG")
     test = _select_subjects(data, DEMO_TEST_SUBJECTS, "PRECOG")
-    pipe = _make_model(args, 0 if args.quiet else 1)
-    _info(args, f"training method {args.method} on subjects {DEMO_TRAIN_SUBJECTS}")
+    joints = _joints(args, train)
+    pipe = _make_model(args, 0 if args.quiet else 1, joints)
+    _info(
+        args,
+        f"training method {args.method} (joints {joints}) on subjects "
+        f"{DEMO_TRAIN_SUBJECTS}",
+    )
     start = time.perf_counter()
     pipe.fit(train.X, train.y)
     seconds = time.perf_counter() - start
@@ -386,9 +428,8 @@ def cmd_demo(args):
         path = save_model(
             pipe,
             args.output,
-            metadata={"method": args.method, "data": "precog", "target_names": list(
-                map(str, data.target_names)
-            )},
+            metadata={"method": args.method, "joints": joints, "data": "precog",
+                      "target_names": list(map(str, data.target_names))},
         )  # fmt: skip
         print(f"model written to {path}")
     return 0

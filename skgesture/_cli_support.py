@@ -1,27 +1,40 @@
 """What the subcommands of the ``skgesture`` command line share.
 
 The error for a user mistake (:class:`UsageError`), status lines and progress
-bars, reading the data named on the command line, building the model of
-``--method`` and loading a model file, and the scores that ``evaluate`` and
-``demo`` print (computed by :mod:`skgesture.metrics`). The subcommands are in
-:mod:`skgesture._cli_commands`, the parser and ``main`` in :mod:`skgesture._cli`.
+bars (as plain lines where stderr is no terminal: :class:`ProgressLines`),
+reading the data named on the command line, the joints of ``--joints auto``,
+building the model of ``--method`` and loading a model file, and the scores
+that ``evaluate`` and ``demo`` print (computed by :mod:`skgesture.metrics`).
+The subcommands are in :mod:`skgesture._cli_commands`, the parser and
+``main`` in :mod:`skgesture._cli`.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import contextlib
 import re
 import sys
+import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["UsageError"]
+__all__ = ["UsageError", "ProgressLines", "plain_progress"]
 
 BUILTIN_DATA = ("precog", "synthetic")
 F1_OVERLAPS = (0.1, 0.25, 0.5)
 FAST_MLP_HIDDEN = 32  # units of the one-layer networks of --fast (Methods A/B)
 FAST_TAGGER_HIDDEN = (16,)  # --fast tagger (Methods C and recommended)
 FAST_MAX_EPOCHS = 60
+# --fast recommended model: a one-stage TCN on fewer, smaller batches (about
+# 30 times less work per epoch than the default's 3 stages of 8 layers).
+FAST_TCN = {"tcn_stages": 1, "tcn_layers": 6, "steps_per_epoch": 5, "batch_size": 8}
+PROGRESS_LINE_SECONDS = 10.0  # a bar's state at most this often, stderr no terminal
+# What tqdm writes to redraw its bars: a carriage return before each state, and
+# newlines and "cursor up" around the states of nested bars.
+_CURSOR_UP = "\x1b[A"
+_BAR_CONTROL = re.compile("(\r|\n|\x1b\\[A)")
 _CHALEARN_NAME = re.compile(
     r"^Sample\d{4,5}(\.zip|_(skeleton|labels|data|prediction)\.csv)?$", re.I
 )
@@ -41,12 +54,200 @@ def _info(args, message):
 
 
 def _progress(args, iterable, desc, total=None, unit="seq"):
-    """A tqdm bar over ``iterable`` (stderr), or the bare iterable with --quiet."""
+    """A tqdm bar over ``iterable`` (stderr), or the bare iterable with --quiet.
+
+    Where stderr is no terminal the bar's states become plain lines
+    (:func:`plain_progress`).
+    """
     if args.quiet:
         return iterable
     from tqdm.auto import tqdm
 
     return tqdm(iterable, desc=desc, total=total, unit=unit, leave=False)
+
+
+def _live_bars():
+    """Whether progress bars are redrawn in place (stderr is a terminal)."""
+    return not isinstance(sys.stderr, ProgressLines)
+
+
+class ProgressLines:
+    """A text stream that writes progress bars as plain lines to another one.
+
+    tqdm redraws a bar in place: a carriage return (``\\r``) before each
+    state, and newlines and "cursor up" escapes around the states of nested
+    bars. In a log file or a pipe that makes one long line full of control
+    characters. This stream passes ordinary text through and writes each bar
+    as whole lines: its first state at once, then its latest state at most
+    every ``interval`` seconds, and its last state when the bar is cleared or
+    closed, before the next ordinary line and at :meth:`finish`. Nothing it
+    writes holds a carriage return or an escape.
+
+    Parameters
+    ----------
+    target : file-like
+        The stream written to (``sys.stderr``).
+    interval : float, default=PROGRESS_LINE_SECONDS
+        Seconds between two lines of one bar, at least.
+    clock : callable, default=time.monotonic
+        The time in seconds.
+
+    Examples
+    --------
+    >>> import io
+    >>> from tqdm import tqdm
+    >>> out = io.StringIO()
+    >>> lines = ProgressLines(out, interval=60)
+    >>> for _ in tqdm(range(3), desc="work", file=lines, leave=False,
+    ...               mininterval=0, bar_format="{desc}: {n}/{total}"):
+    ...     pass
+    >>> lines.finish()
+    >>> print(out.getvalue(), end="")
+    work: 0/3
+    work: 3/3
+    """
+
+    def __init__(self, target, interval=PROGRESS_LINE_SECONDS, clock=time.monotonic):
+        self.target = target
+        self.interval = interval
+        self.clock = clock
+        self._line = ""  # ordinary text of the current line, not yet ended
+        self._row = 0  # the line below the first bar that tqdm's cursor is on
+        self._bars = {}  # row -> _BarLines
+        self._after_bar = False  # the last thing written was a bar's
+
+    def write(self, text):
+        """Write ``text``; a bar's state follows a carriage return.
+
+        tqdm draws one state with one call (``"\\r" + state``), so the text
+        after a carriage return, up to the end of the call or the next control
+        character, is one state of the bar on the current row.
+        """
+        text = str(text)
+        state = None  # the state being drawn by this call
+        for token in _BAR_CONTROL.split(text):
+            if token == "\r":
+                if state is not None:
+                    self._bar_state(state)
+                state = ""
+            elif token in ("\n", _CURSOR_UP):
+                if state is not None:
+                    self._bar_state(state)
+                    state = None
+                if token == _CURSOR_UP:
+                    self._row = max(self._row - 1, 0)
+                elif self._line or not self._after_bar:
+                    self._end_line()
+                else:  # a bare newline between bars moves to the next bar
+                    self._row += 1
+            elif state is not None:
+                state += token
+            elif token:
+                self._line += token
+                self._after_bar = False
+        if state is not None:
+            self._bar_state(state)
+        return len(text)
+
+    def _emit(self, line):
+        self.target.write(line + "\n")
+
+    def _bar_state(self, state):
+        state = state.strip()
+        self._after_bar = True
+        bar = self._bars.setdefault(self._row, _BarLines())
+        if not state:  # the bar was cleared: its last state, and a new bar may come
+            bar.write_pending(self._emit)
+            del self._bars[self._row]
+            return
+        now = self.clock()
+        bar.pending = state
+        if bar.time is None or now - bar.time >= self.interval:
+            bar.write_pending(self._emit)
+            bar.time = now
+
+    def _write_pending(self):
+        for row in sorted(self._bars):
+            self._bars[row].write_pending(self._emit)
+        self._bars.clear()
+
+    def _end_line(self):
+        self._write_pending()
+        self._emit(self._line)
+        self._line = ""
+        self._row = 0
+        self._after_bar = False
+
+    def flush(self):
+        """Flush the target (a bar's state waiting for its interval stays)."""
+        self.target.flush()
+
+    def finish(self):
+        """Write the bars' last states and any unfinished line; flush."""
+        self._write_pending()
+        if self._line:
+            self._emit(self._line)
+            self._line = ""
+        self.flush()
+
+    def isatty(self):
+        """False: bars are written as lines."""
+        return False
+
+    def __getattr__(self, name):  # fileno, encoding, ...: the target's
+        return getattr(self.target, name)
+
+
+class _BarLines:
+    """What :class:`ProgressLines` knows of one bar."""
+
+    def __init__(self):
+        self.pending = None  # the latest state, not yet written
+        self.time = None  # when a state was last written
+        self.written = None  # the progress part of the last state written
+
+    def write_pending(self, emit):
+        """Write the pending state, unless it shows no progress since the last.
+
+        The progress part is the state up to its times (``" ["``): a bar's
+        final redraw on close repeats its last state with another rate.
+        """
+        if self.pending is None:
+            return
+        progress = self.pending.split(" [", 1)[0]
+        if progress != self.written:
+            emit(self.pending)
+            self.written = progress
+        self.pending = None
+
+
+def _isatty(stream):
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
+@contextlib.contextmanager
+def plain_progress(args):
+    """Progress bars as plain lines (:class:`ProgressLines`) where stderr is
+    no terminal, for the duration of the block.
+
+    tqdm writes to ``sys.stderr`` as it is when a bar starts, so the bars of
+    the library (training epochs, files read) are plain lines too.
+    """
+    target = sys.stderr
+    if getattr(args, "quiet", False) or _isatty(target):
+        yield None
+        return
+    lines = ProgressLines(target)
+    sys.stderr = lines
+    try:
+        yield lines
+    finally:
+        if sys.stderr is lines:
+            sys.stderr = target
+        lines.finish()
 
 
 # -- data ------------------------------------------------------------------------
@@ -180,6 +381,71 @@ def _fps(data):
 # -- models ----------------------------------------------------------------------
 
 
+def _data_joints(data):
+    """The joints of ``--joints auto``: those the data track.
+
+    ``"full20"`` when each of the 20 Kinect v1 joints has a position (finite,
+    not all zero) in some frame, as every loader gives them; ``"paper11"``
+    when only the paper's 11 upper-body joints do (Kinect's seated mode,
+    say). Frames of another shape get ``"full20"``, for the model to reject.
+    """
+    from skgesture.layouts import KINECT_V1, N_COORDS, PAPER_11
+
+    shape = (KINECT_V1.n_joints, N_COORDS)
+    tracked = np.zeros(KINECT_V1.n_joints, dtype=bool)
+    for x in data.X:
+        x = np.ma.filled(np.ma.asarray(x, dtype=float), np.nan)
+        if x.shape[1:] != shape:
+            return "full20"
+        seen = np.isfinite(x).all(axis=-1) & (x != 0).any(axis=-1)
+        tracked |= seen.any(axis=0)
+        if tracked.all():
+            return "full20"
+    missing = [n for n, t in zip(KINECT_V1.joint_names, tracked) if not t]
+    if not set(PAPER_11.joints) & set(missing):
+        return "paper11"
+    raise UsageError(
+        f"--joints auto: the data never track {', '.join(missing)}, not even "
+        f"the 11 upper-body joints of paper11 are all there; give --joints "
+        f"paper11 or full20 to train anyway"
+    )
+
+
+def _joints(args, data):
+    """``--joints``, ``auto`` resolved on ``data``."""
+    return _data_joints(data) if args.joints == "auto" else args.joints
+
+
+def _check_device(device):
+    """``--device`` as torch reads it, or a :class:`UsageError` saying why not.
+
+    Checked before any work: torch would only fail in the first epoch, with an
+    ``AssertionError`` or ``RuntimeError`` that reads like a bug.
+    """
+    import torch
+
+    try:
+        dev = torch.device(device)
+    except (RuntimeError, ValueError, TypeError):
+        raise UsageError(
+            f"--device {device}: not a torch device (e.g. cpu, cuda, cuda:1, mps)"
+        ) from None
+    if dev.type == "cuda":
+        if not torch.cuda.is_available():
+            raise UsageError(
+                f"--device {device}: CUDA is not available to this torch "
+                f"({torch.__version__}); use --device cpu"
+            )
+        if dev.index is not None and dev.index >= torch.cuda.device_count():
+            raise UsageError(
+                f"--device {device}: there are {torch.cuda.device_count()} CUDA "
+                f"device(s), cuda:0 to cuda:{torch.cuda.device_count() - 1}"
+            )
+    elif dev.type == "mps" and not torch.backends.mps.is_available():
+        raise UsageError(f"--device {device}: MPS is not available; use --device cpu")
+    return dev
+
+
 def _set_if_present(est, **params):
     """``est.set_params`` for the parameters it has."""
     known = est.get_params(deep=False)
@@ -189,14 +455,14 @@ def _set_if_present(est, **params):
     return est
 
 
-def _make_model(args, verbose):
-    """The unfitted pipeline of ``--method`` with the size options applied."""
+def _make_model(args, verbose, joints):
+    """The unfitted pipeline of ``--method`` on ``joints``, size options applied."""
     import skgesture
     from skgesture._multiscale._classifier import default_window_network
     from skgesture._segmenter import default_frame_network
 
     method = args.method
-    common = {"joints": args.joints, "random_state": args.seed, "verbose": verbose}
+    common = {"joints": joints, "random_state": args.seed, "verbose": verbose}
     if method == "recommended":
         make = getattr(skgesture, "make_recommended", None)
         if make is None:
@@ -235,6 +501,8 @@ def _make_model(args, verbose):
         _set_if_present(last, max_epochs=epochs)
         if args.fast:
             _set_if_present(last, hidden_sizes=FAST_TAGGER_HIDDEN)
+            if method == "recommended":
+                _set_if_present(last, **FAST_TCN)
     return pipe
 
 
@@ -263,8 +531,39 @@ def _target_names(data, info=None):
     return None if names is None else [str(n) for n in names]
 
 
-def _predict(args, model, X):
-    """Per-frame labels of every sequence, with a progress bar."""
+def _min_gesture_frames(model):
+    """``(frames, why)``: the shortest recording in which ``model`` can find a
+    gesture (the segmenter's ``min_length``, a tagger's ``min_run``), or None."""
+    from skgesture import ActivitySegmenter
+
+    steps = [est for _, est in getattr(model, "steps", [("model", model)])]
+    for est in steps:
+        if isinstance(est, ActivitySegmenter):
+            n = int(est.min_length)
+            return n, f"its segmenter drops activity shorter than min_length={n}"
+    min_run = getattr(steps[-1], "min_run", None)
+    if isinstance(min_run, (int, np.integer)) and min_run > 1:
+        n = int(min_run)
+        return n, f"its tagger drops runs shorter than min_run={n}"
+    return None
+
+
+def _predict(args, model, X, ids=None):
+    """Per-frame labels of every sequence, with a progress bar; a recording too
+    short for the model to find any gesture in gets a warning that says so."""
+    floor = _min_gesture_frames(model)
+    if floor is not None:
+        n_min, why = floor
+        for i, x in enumerate(X):
+            if len(x) < n_min:
+                sid = f"recording {i}" if ids is None else str(ids[i])
+                warnings.warn(
+                    f"{sid}: {len(x)} frames, shorter than the {n_min} frames in "
+                    f"which this model can find a gesture ({why}); it is predicted "
+                    f"as rest throughout",
+                    UserWarning,
+                    stacklevel=2,
+                )
     return [
         np.asarray(model.predict([x])[0])
         for x in _progress(args, X, "predicting", total=len(X))

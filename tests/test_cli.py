@@ -1,7 +1,9 @@
 """The command line, through ``main(argv)`` and once through the console script."""
 
+import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -102,6 +104,160 @@ def test_console_script_and_module():
     assert "evaluate" in out.stdout
 
 
+def _python_env():
+    """The environment of a ``python -m skgesture`` child: this checkout, quiet."""
+    env = {**os.environ, "PYTHONWARNINGS": "ignore"}
+    root = str(Path(skgesture.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH")]))
+    return env
+
+
+@pytest.mark.parametrize(
+    "argv, prog, given, closest",
+    [
+        (["train", *SYNTH, "--data", "3"], "skgesture train", "--data", "--data-seed"),
+        (["train", "synthetic", "--n-seq", "3"], "skgesture train", "--n-seq", None),
+        (["train", "synthetic", "--n-seq=3"], "skgesture train", "--n-seq", None),
+        (
+            ["evaluate", "m.skg", "synthetic", "--jsn"],
+            "skgesture evaluate",
+            "--jsn",
+            None,
+        ),
+        (
+            ["stream", "m.skg", "synthetic", "--real"],
+            "skgesture stream",
+            "--real",
+            None,
+        ),
+        (["--tracebak", "-q"], "skgesture", "--tracebak", "--traceback"),
+    ],
+)
+def test_options_are_not_abbreviated(tmp_path, capsys, argv, prog, given, closest):
+    """A prefix of an option is an unknown option, with the closest suggested
+    under the subcommand's own usage (status 2, no traceback)."""
+    closest = (
+        closest
+        or {
+            "--n-seq": "--n-sequences",
+            "--jsn": "--json",
+            "--real": "--realtime",
+        }[given]
+    )
+    if argv[0] != "--tracebak":
+        argv = [*argv, "-o", tmp_path / "m.skg", *TINY]
+    status, out, err = run(argv, capsys)
+    assert status == 2, (out, err)
+    assert "Traceback" not in err
+    assert err.startswith(f"usage: {prog} [-h]"), err
+    last = err.rstrip().splitlines()[-1]
+    assert last == f"{prog}: error: unknown option {given}; did you mean {closest}?"
+    assert not (tmp_path / "m.skg").exists()
+
+
+def test_no_parser_takes_abbreviations():
+    from skgesture._cli import build_parser
+
+    parser = build_parser()
+    assert parser.allow_abbrev is False
+    assert set(parser.commands) == {
+        "train",
+        "evaluate",
+        "predict",
+        "plot",
+        "stream",
+        "demo",
+    }
+    assert all(p.allow_abbrev is False for p in parser.commands.values())
+
+
+def test_unknown_argument_without_a_close_option(capsys):
+    status, _, err = run(["train", "synthetic", "-x"], capsys)
+    assert status == 2
+    assert err.rstrip().splitlines()[-1] == "skgesture train: error: unknown option -x"
+    status, _, err = run(["train", "synthetic", "more"], capsys)
+    assert status == 2
+    assert err.rstrip().splitlines()[-1].endswith("unrecognized arguments: more")
+
+
+def test_broken_pipe_exits_quietly(model_b):
+    """`skgesture ... | head -1`: the reader goes away; no traceback, status 141.
+
+    Buffered output meets the closed pipe when it is flushed (at the end),
+    unbuffered output (PYTHONUNBUFFERED) at its first line.
+    """
+    evaluate = ["evaluate", str(model_b), *HELD_OUT]
+    for argv, buffered in [(evaluate, True), (evaluate, False), (["--help"], True)]:
+        env = _python_env()
+        env.pop("PYTHONUNBUFFERED", None)
+        if not buffered:
+            env["PYTHONUNBUFFERED"] = "1"
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "skgesture", *argv],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            env=env,
+        )
+        proc.stdout.close()  # the reader closes before the first line comes
+        err = proc.stderr.read().decode()
+        proc.stderr.close()
+        assert proc.wait() == 141, (argv, buffered, err)
+        assert "Traceback" not in err and "Exception ignored" not in err, err
+        assert "error" not in err.lower() and "pipe" not in err.lower(), err
+
+
+def test_progress_bars_are_plain_lines_in_a_log(tmp_path):
+    """stderr no terminal: every bar (the loader's, the networks' epochs) is
+    written as whole lines, never redrawn with a carriage return."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "skgesture", "train", *SYNTH, "--method", "B"]
+        + ["--fast", "--max-epochs", "5", "-o", str(tmp_path / "m.skg")],
+        capture_output=True,
+        text=False,
+        env=_python_env(),
+    )
+    err = proc.stderr.decode()
+    assert proc.returncode == 0, err
+    assert "\r" not in err and "\x1b" not in err, repr(err)
+    assert re.search(r"epoch", err), err  # the networks' bars, as lines
+    assert "training method B" in err
+
+
+def test_progress_lines_of_nested_bars():
+    from tqdm import tqdm
+
+    from skgesture._cli_support import ProgressLines
+
+    clock = [0.0]
+    out = io.StringIO()
+    lines = ProgressLines(out, interval=10, clock=lambda: clock[0])
+    options = {
+        "file": lines,
+        "mininterval": 0,
+        "bar_format": "{desc}: {n}/{total} [{rate_fmt}]",
+    }
+    for _ in tqdm(range(2), desc="scales", **options):
+        for _ in tqdm(range(6), desc="epochs", leave=False, **options):
+            clock[0] += 3  # a line at most every 10 s
+    print("done", file=lines)
+    lines.finish()
+    text = out.getvalue()
+    assert "\r" not in text and "\x1b" not in text
+    got = [line.split(" [")[0] for line in text.splitlines()]
+    assert got == [
+        "scales: 0/2",
+        "epochs: 0/6",
+        "epochs: 4/6",  # 12 s later
+        "epochs: 6/6",  # cleared: the last state
+        "scales: 1/2",
+        "epochs: 0/6",
+        "epochs: 4/6",
+        "epochs: 6/6",
+        "scales: 2/2",  # once, though closing redraws it
+        "done",
+    ]
+
+
 # -- train, evaluate, predict ----------------------------------------------------------
 
 
@@ -122,6 +278,49 @@ def test_train_writes_a_safe_model_file(model_b):
             "manifest.json",
             "weights.safetensors",
         ]
+
+
+def test_train_defaults_to_the_recommended_model_on_the_data_joints(tmp_path, capsys):
+    """No --method, no --joints: make_recommended on the 20 joints every loader
+    gives (README, docs/choosing.md)."""
+    path = tmp_path / "default.skg"
+    with torch.random.fork_rng(devices=[]):
+        status, out, err = run(["train", *SYNTH, *TINY, "-o", path], capsys)
+    assert status == 0, err
+    assert "trained method recommended" in out
+    from skgesture._persistence import model_info
+
+    meta = model_info(path)["metadata"]
+    assert (meta["method"], meta["joints"]) == ("recommended", "full20")
+    model = load_model(path)
+    assert [name for name, _ in model.steps] == ["features", "tagger"]
+    assert model.named_steps["features"].joints == "full20"
+    assert model.named_steps["tagger"].architecture == "tcn"
+    status, out, _ = run(["train", "--help"], capsys)
+    assert status == 0
+    assert re.search(r"make_recommended;\s+the default", out), out
+
+
+def test_default_joints_are_those_the_data_track():
+    from sklearn.utils import Bunch
+
+    from skgesture._cli_support import UsageError, _data_joints
+    from skgesture.layouts import KINECT_V1, PAPER_11
+
+    X = make_gesture_streams(n_sequences=2, n_classes=3, random_state=0).X
+    assert _data_joints(Bunch(X=X)) == "full20"
+    legs = [
+        KINECT_V1.index(n) for n in KINECT_V1.joint_names if n not in PAPER_11.joints
+    ]
+    seated = [x.copy() for x in X]
+    for x in seated:
+        x[:, legs] = 0.0  # Kinect's seated mode: no legs
+    seated[1][:, legs] = np.nan
+    assert _data_joints(Bunch(X=seated)) == "paper11"
+    seated[0][:, KINECT_V1.index("Head")] = 0.0
+    seated[1][:, KINECT_V1.index("Head")] = 0.0
+    with pytest.raises(UsageError, match="never track .*Head"):
+        _data_joints(Bunch(X=seated))
 
 
 def test_evaluate_json_matches_the_api(model_b, held_out, capsys):
@@ -401,6 +600,42 @@ def test_train_refuses_to_overwrite(model_b, capsys):
     _assert_one_line_error(status, err, "--overwrite")
 
 
+def test_a_model_that_cannot_stream_is_one_line(model_b, tmp_path, capsys):
+    """A TypeError of the library's validation is a user mistake."""
+    from sklearn.pipeline import Pipeline
+
+    from skgesture import save_model
+
+    segmenter_only = Pipeline(load_model(model_b).steps[:2])  # no classifier
+    path = save_model(segmenter_only, tmp_path / "segmenter.skg")
+    status, _, err = run(["stream", path, *HELD_OUT, "-q"], capsys)
+    _assert_one_line_error(status, err, "gives no gesture segments")
+
+
+@pytest.mark.parametrize("device", ["bogus", "cuda"])
+def test_unusable_device(tmp_path, capsys, device):
+    """Checked before training: torch's own errors (RuntimeError, AssertionError)
+    would come in the first epoch and read like a bug."""
+    if device == "cuda" and torch.cuda.is_available():
+        pytest.skip("CUDA is available here")
+    status, _, err = run(
+        ["train", *SYNTH, *TINY, "--device", device, "-o", tmp_path / "m.skg"], capsys
+    )
+    _assert_one_line_error(status, err, f"--device {device}")
+    assert not (tmp_path / "m.skg").exists()
+
+
+def test_a_bug_shows_its_traceback(monkeypatch, capsys):
+    """A TypeError that no validation raised (here: a helper returning None)
+    is a bug: it propagates, as every error that is no user mistake."""
+    import skgesture._cli_commands as commands
+
+    monkeypatch.setattr(commands, "_n_frames", lambda data: None)
+    with pytest.raises(TypeError, match="NoneType"):
+        main(["train", *SYNTH, *TINY, "-o", "never-written.skg"])
+    assert not Path("never-written.skg").exists()
+
+
 def test_traceback_flag_shows_the_error(tmp_path):
     with pytest.raises(FileNotFoundError):
         main(["--traceback", "evaluate", str(tmp_path / "nope.skg"), *SYNTH])
@@ -449,6 +684,22 @@ def test_stream_prints_events_with_delays(model_b, held_out, capsys):
     assert f"{len(expected)} events" in out.splitlines()[-1]
 
 
+def test_stream_delays_are_within_the_printed_bound(model_b, capsys):
+    """Method B: the gestures that end early in a long activity period wait for
+    it to be known long, beyond max_delay (21; 49 frames in this sequence); the
+    printed bound says so."""
+    status, out, err = run(
+        ["stream", model_b, *HELD_OUT, "--sequence", "1", "-q"], capsys
+    )
+    assert status == 0, err
+    bound = int(re.search(r"events come at most (\d+) frames", out).group(1))
+    delays = [int(d) for d in re.findall(r"delay (\d+) frames \(", out)]
+    assert delays, out
+    assert max(delays) <= bound, out
+    assert bound == 11 + 55 - 1  # lookahead + short_length - 1 (docs/streaming.md)
+    assert "first 55 frames of a longer activity period" in out
+
+
 def test_stream_drives_the_robot(model_b, capsys):
     status, out, err = run(
         ["stream", model_b, *HELD_OUT, "--robot", "--commands", "1,2,3,1,2", "-q"],
@@ -469,3 +720,33 @@ def test_demo(capsys):
     assert status == 0, err
     assert "PRECOG" in out and "held-out subjects 7-8" in out
     assert "Jaccard index (official 2014)" in out
+
+
+# -- documents ---------------------------------------------------------------------
+
+
+def test_readme_lists_every_document():
+    root = Path(__file__).resolve().parents[1]
+    readme = (root / "README.md").read_text()
+    section = readme.split("## Documentation", 1)[1].split("\n## ", 1)[0]
+    for doc in sorted((root / "docs").glob("*.md")):
+        assert f"`docs/{doc.name}`" in section, doc.name
+
+
+def test_a_recording_too_short_for_the_model_gets_a_warning(model_b, held_out):
+    """Not 'Jaccard nan' after generic warnings: the warning names the recording
+    and the model's floor (Method B: the segmenter's min_length)."""
+    import argparse
+
+    from skgesture._cli_support import _predict
+
+    model = load_model(model_b)
+    floor = model.named_steps["segmenter"].min_length
+    X = [held_out.X[0][: floor - 1], held_out.X[1]]
+    args = argparse.Namespace(quiet=True)
+    match = rf"short_take: {floor - 1} frames, shorter than the {floor} frames"
+    with pytest.warns(UserWarning, match=match + rf".*min_length={floor}") as record:
+        y_pred = _predict(args, model, X, ["short_take", "long_take"])
+    assert [len(p) for p in y_pred] == [len(x) for x in X]
+    assert not any("long_take" in str(w.message) for w in record)
+    assert not y_pred[0].any()  # rest throughout, as the warning says
