@@ -232,5 +232,6 @@ def test_commander_refuses_the_wrong_objects():
         GestureCommander(rec, {1: "move_to_tool"}, robot)
     with pytest.raises(TypeError, match="robot must be a PickAndPlaceRobot"):
         GestureCommander(rec, amap, "robot")
-    with pytest.raises(TypeError, match="robot must be"):
-        GestureCommander(rec, amap, robot=None)
+    with pytest.raises(TypeError, match="robot must be a PickAndPlaceRobot or None"):
+        GestureCommander(rec, amap, robot=object())
+    assert GestureCommander(rec, amap, robot=None).robot is None  # publish only

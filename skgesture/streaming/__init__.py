@@ -6,7 +6,10 @@
 * :class:`ActionMap`, :class:`PickAndPlaceRobot` / :class:`SimulatedRobot`
   (with :class:`RobotCommand`, :class:`RobotState`) and
   :class:`GestureCommander` turn events into the paper's pick-and-place
-  commands.
+  commands; :class:`CommandMap` maps any gesture vocabulary to any commands,
+  with an optional state machine (a JSON or TOML file), and
+  :class:`JSONLinesPublisher` / :class:`UDPPublisher` publish each
+  :class:`CommandEvent` as JSON.
 * Adapters map Kinect v2, Azure Kinect, MediaPipe Pose and MSR Action3D
   skeletons to the Kinect v1 layout of the models; :class:`SkeletonSource`
   is the interface of a source, :class:`ReplaySource` replays a recording,
@@ -43,6 +46,12 @@ from skgesture.streaming._adapters import (
     SkeletonAdapter,
     get_adapter,
 )
+from skgesture.streaming._commands import (
+    CommandEvent,
+    CommandMap,
+    JSONLinesPublisher,
+    UDPPublisher,
+)
 from skgesture.streaming._recognizer import GestureEvent, StreamingRecognizer
 from skgesture.streaming._sources import (
     LSLSource,
@@ -59,9 +68,12 @@ __all__ = [
     "ActionDecision",
     "ActionMap",
     "AzureKinectAdapter",
+    "CommandEvent",
+    "CommandMap",
     "CommandResult",
     "GestureCommander",
     "GestureEvent",
+    "JSONLinesPublisher",
     "KinectV1Adapter",
     "KinectV2Adapter",
     "LSLSource",
@@ -76,6 +88,7 @@ __all__ = [
     "SkeletonSource",
     "StdinSource",
     "StreamingRecognizer",
+    "UDPPublisher",
     "UDPSource",
     "get_adapter",
 ]

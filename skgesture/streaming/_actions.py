@@ -7,7 +7,9 @@ commands (confidence floor, refractory period: one gesture, one command);
 :class:`PickAndPlaceRobot` is the task's state machine, which refuses commands
 out of order, with :class:`SimulatedRobot` as a ready-made implementation and
 the place where a real robot plugs in (:meth:`PickAndPlaceRobot._perform`);
-:class:`GestureCommander` wires a recogniser, a map and a robot together.
+:class:`GestureCommander` wires a recogniser, a map, the state machine of a
+:class:`~skgesture.streaming.CommandMap` (any vocabulary, ``_commands.py``), a
+robot and the command publishers together.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -18,6 +20,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
 from numbers import Integral, Real
+
+from skgesture.streaming._commands import CommandEvent, CommandMap, resolve_classes
 
 __all__ = [
     "RobotCommand",
@@ -116,12 +120,14 @@ class CommandResult:
 
     Parameters
     ----------
-    command : RobotCommand
+    command : RobotCommand or object
         The command.
     accepted : bool
         Whether it was executed.
-    state_before, state_after : RobotState
-        Robot state around it (equal when refused).
+    state_before, state_after : RobotState, str or None
+        Robot state around it (equal when refused); for a result made by a
+        :class:`GestureCommander` (no robot, or a command its state machine
+        rejected), the commander's state (None without a state machine).
     reason : str
         ``"ok"`` or why it was refused.
     frame : int or None, default=None
@@ -319,15 +325,21 @@ class ActionMap:
     one gesture, even if it is recognised as two overlapping events, gives
     one command.
 
+    The classes are checked against a model by :meth:`bind`, which
+    :class:`GestureCommander` calls with its recogniser's classes: a class the
+    model does not have, or one given twice, is an error then.
+
     Parameters
     ----------
-    mapping : dict
+    mapping : dict or CommandMap
         ``{gesture class: command}``. A class is its label (an int >= 1, as in
         ``y``) or its name (a str): names are turned into labels with
         ``target_names`` when given, else matched against the ``name`` of each
         event (set when the recogniser has ``target_names``). Commands are
         :class:`RobotCommand` values (strings such as ``"close_gripper"`` are
-        converted) or any object for other programs.
+        converted) or any object for other programs. A :class:`CommandMap`
+        (e.g. read from a file) gives its commands and its state machine,
+        which :class:`GestureCommander` enforces.
     min_confidence : float, default=0.0
         Confidence floor, in [0, 1].
     refractory_frames : int, default=0
@@ -341,7 +353,9 @@ class ActionMap:
     mapping : dict
         ``{label: command}`` for the classes given as labels or named through
         ``target_names``, ``{name: command}`` for names matched at decision
-        time.
+        time (until :meth:`bind` resolves them).
+    command_map : CommandMap or None
+        The map given as ``mapping`` (bound by :meth:`bind`), else None.
 
     Examples
     --------
@@ -380,6 +394,10 @@ class ActionMap:
                 "refractory_frames must be a non-negative int, got "
                 f"{refractory_frames!r}"
             )
+        self.command_map = None
+        if isinstance(mapping, CommandMap):
+            self.command_map = mapping
+            mapping = mapping.mapping if mapping.bound else mapping.commands
         if not isinstance(mapping, Mapping):
             raise TypeError(
                 "mapping must be a dict {gesture class: command}, got "
@@ -395,6 +413,8 @@ class ActionMap:
         self.target_names = None if target_names is None else list(target_names)
         self.mapping = {}
         for key, command in mapping.items():
+            if self.command_map is not None and isinstance(key, str):
+                key = int(key) if key.strip().isdecimal() else key.strip()
             cls = self._class_key(key)
             if cls in self.mapping:
                 raise ValueError(
@@ -433,6 +453,48 @@ class ActionMap:
                 f"({len(self.target_names)} classes)"
             )
         return int(key)
+
+    def bind(self, classes, target_names=None):
+        """Check the mapping against a model's classes; resolve class names.
+
+        Parameters
+        ----------
+        classes : array-like of int
+            The model's gesture classes (``recognizer.classes_``).
+        target_names : sequence of str or None, default=None
+            The model's class names; defaults to the map's ``target_names``.
+
+        Returns
+        -------
+        ActionMap
+            ``self``, with :attr:`mapping` ``{label: command}``.
+
+        Raises
+        ------
+        ValueError
+            For a class the model does not have (a number not among
+            ``classes``, a name not in ``target_names`` or a name without
+            them) and for a class given twice (by name and by number).
+
+        Examples
+        --------
+        >>> from skgesture.streaming import ActionMap
+        >>> ActionMap({1: "move_to_tool", 9: "beep"}).bind([1, 2, 3, 4])
+        Traceback (most recent call last):
+        ...
+        ValueError: mapping[9]: class 9 is not a class of the model (its \
+classes are 1, 2, 3, 4)
+        """
+        names = self.target_names if target_names is None else list(target_names)
+        if self.command_map is not None:
+            self.command_map = self.command_map.bind(classes, names)
+            self.mapping = {
+                k: _as_command(c) for k, c in self.command_map.mapping.items()
+            }
+        else:
+            entries = [(k, k, c) for k, c in self.mapping.items()]
+            self.mapping = resolve_classes(entries, classes, names)
+        return self
 
     def reset(self):
         """Forget the last issued command."""
@@ -500,23 +562,52 @@ def _as_command(value):
 
 
 class GestureCommander:
-    """Recogniser -> action map -> robot, frame by frame.
+    """Recogniser -> action map -> state machine -> robot and publishers.
+
+    Every event of the recogniser goes through the action map (confidence
+    floor, refractory period). An issued command is then checked against the
+    state machine of the map's :class:`CommandMap`, if it has one: a command
+    that is not valid in the current state is rejected (neither executed nor
+    published) and counted in :attr:`n_rejected`. It is executed by the robot,
+    if there is one (which may refuse it too), and, once carried out, the
+    state machine moves on and a :class:`CommandEvent` goes to every
+    ``on_command`` callback.
 
     Parameters
     ----------
     recognizer : StreamingRecognizer
         Gives gesture events.
-    action_map : ActionMap
-        Turns them into commands.
-    robot : PickAndPlaceRobot
-        Executes the commands.
+    action_map : ActionMap or CommandMap
+        Turns them into commands; a :class:`CommandMap` is used as
+        ``ActionMap(command_map)`` (no floor, no refractory period). When the
+        recogniser has ``classes_`` (a :class:`StreamingRecognizer` does), the
+        map is bound to them and to its ``target_names``
+        (:meth:`ActionMap.bind`): a class the model does not have, or one
+        given twice, is a ValueError here rather than a gesture that never
+        commands anything.
+    robot : PickAndPlaceRobot or None, default=None
+        Executes the commands; None when the commands are only published.
+    on_command : callable, sequence of callable or None, default=None
+        Called with the :class:`CommandEvent` of every command carried out:
+        a :class:`JSONLinesPublisher`, a :class:`UDPPublisher` or any
+        function.
+    fps : float or None, default=None
+        Frame rate of the stream, for :attr:`CommandEvent.time`.
 
     Attributes
     ----------
     log : list of tuple
         ``(decision, result)`` for every event: the :class:`ActionDecision`
-        and the robot's :class:`CommandResult` (None when no command was
-        issued).
+        and the :class:`CommandResult` (None when no command was issued). A
+        command the state machine rejects has a result made here, with
+        ``accepted`` False, the commander's states and the reason; otherwise
+        the result is the robot's, or, without a robot, one that accepts.
+    state : str or None
+        Current state of the map's state machine (None without one).
+    n_rejected : int
+        Commands rejected by the state machine.
+    published : list of CommandEvent
+        Every command carried out, as published.
 
     Examples
     --------
@@ -537,24 +628,89 @@ class GestureCommander:
     >>> all(result is None or result.command == "move_to_tool"
     ...     for _, result in log)
     True
+
+    Without a robot, with a state machine and a callback:
+
+    >>> from skgesture.streaming import CommandMap, GestureEvent
+    >>> cmap = CommandMap({1: "pick", 2: "place"},
+    ...                   states={"idle": {"pick": "holding"},
+    ...                           "holding": {"place": "idle"}}, initial="idle")
+    >>> class Events:  # a stand-in recogniser that gives one event per frame
+    ...     def push(self, label):
+    ...         return [GestureEvent(label, 0, 10, 0.9, emitted_at=20)]
+    ...     def flush(self):
+    ...         return []
+    >>> commander = GestureCommander(
+    ...     Events(), cmap, on_command=lambda ev: print(ev.command, "->", ev.state))
+    >>> _ = commander.run([1, 1, 2])
+    pick -> holding
+    place -> idle
+    >>> commander.n_rejected, commander.log[1][1].reason
+    (1, "'pick' is not valid in state 'holding' (valid there: place)")
     """
 
-    def __init__(self, recognizer, action_map, robot):
+    def __init__(
+        self, recognizer, action_map, robot=None, *, on_command=None, fps=None
+    ):
+        if isinstance(action_map, CommandMap):
+            action_map = ActionMap(action_map)
         for arg, value, methods, kind in (
             ("recognizer", recognizer, ("push", "flush"), "a StreamingRecognizer"),
             ("action_map", action_map, ("decide",), "an ActionMap"),
-            ("robot", robot, ("execute",), "a PickAndPlaceRobot"),
+            ("robot", robot, ("execute",), "a PickAndPlaceRobot or None"),
         ):
+            if arg == "robot" and value is None:
+                continue
             if not all(callable(getattr(value, m, None)) for m in methods):
                 raise TypeError(
                     f"GestureCommander: {arg} must be {kind} (with "
                     f"{', '.join(m + '()' for m in methods)}), got "
                     f"{type(value).__name__}"
                 )
+        if on_command is None:
+            callbacks = []
+        elif callable(on_command):
+            callbacks = [on_command]
+        else:
+            callbacks = list(on_command) if isinstance(on_command, list | tuple) else []
+            if not callbacks or not all(callable(c) for c in callbacks):
+                raise TypeError(
+                    "GestureCommander: on_command must be a callable (e.g. a "
+                    "JSONLinesPublisher), a list of callables or None, got "
+                    f"{on_command!r}"
+                )
+        if fps is not None and (
+            isinstance(fps, bool) or not isinstance(fps, Real) or not fps > 0
+        ):
+            raise ValueError(f"fps must be a positive number or None, got {fps!r}")
+        classes = getattr(recognizer, "classes_", None)
+        if classes is not None and callable(getattr(action_map, "bind", None)):
+            action_map.bind(classes, getattr(recognizer, "target_names", None))
         self.recognizer = recognizer
         self.action_map = action_map
         self.robot = robot
+        self.on_command = callbacks
+        self.fps = fps
+        self.reset()
+
+    @property
+    def command_map(self):
+        """The action map's :class:`CommandMap`, or None."""
+        return getattr(self.action_map, "command_map", None)
+
+    def reset(self):
+        """Back to the initial state, with an empty log.
+
+        The recogniser and the robot are left as they are (they have their own
+        ``reset``).
+        """
+        cmap = self.command_map
+        self.state = None if cmap is None else cmap.initial
+        self.n_rejected = 0
+        self.published = []
         self.log = []
+        if callable(getattr(self.action_map, "reset", None)):
+            self.action_map.reset()
 
     def push(self, frame):
         """Push one frame; act on the events it completes.
@@ -582,7 +738,7 @@ class GestureCommander:
         return self._act(self.recognizer.flush())
 
     def run(self, source):
-        """Drive the robot from every frame of a source, then flush.
+        """Act on every frame of a source, then flush.
 
         Parameters
         ----------
@@ -605,7 +761,38 @@ class GestureCommander:
             decision = self.action_map.decide(event)
             result = None
             if decision.issued:
-                result = self.robot.execute(decision.command, frame=event.emitted_at)
+                result = self._command(event, decision.command)
             out.append((decision, result))
         self.log += out
         return out
+
+    def _command(self, event, command):
+        frame = event.emitted_at
+        cmap, before = self.command_map, self.state
+        after = None
+        if cmap is not None and cmap.states is not None:
+            after = cmap.next_state(before, command)
+            if after is None:
+                self.n_rejected += 1
+                valid = cmap.allowed(before)
+                where = (
+                    f"valid there: {', '.join(valid)}" if valid
+                    else "no command is valid there"
+                )  # fmt: skip
+                reason = f"{str(command)!r} is not valid in state {before!r} ({where})"
+                return CommandResult(command, False, before, before, reason, frame)
+        if self.robot is None:
+            result = CommandResult(command, True, before, after, "ok", frame)
+        else:
+            result = self.robot.execute(command, frame=frame)
+            if not result.accepted:
+                return result
+        if after is not None:
+            self.state = after
+        published = CommandEvent.from_gesture(
+            event, command, fps=self.fps, state=after, previous=before
+        )
+        self.published.append(published)
+        for callback in self.on_command:
+            callback(published)
+        return result
