@@ -53,6 +53,10 @@ EXIT_ERROR = 1
 EXIT_USAGE = 2
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell shows for `yes | head -1`
 PLOTS = ("timeline", "segmentation", "confusion", "skeleton")
+FPS_HELP = (
+    "frame rate of the data (default: what the data say; your own recordings: "
+    "the model's, else 30)"
+)
 DEFAULT_MAX_TIMELINES = 12  # sequences drawn by `plot timeline`
 
 
@@ -173,11 +177,37 @@ def _add_common(parser):
     )
 
 
-def _add_data(parser, *, with_model=False):
+def _positive(text):
+    """An option's value as a positive finite float (argparse ``type``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive number")
+    return value
+
+
+def _size(text):
+    """``--size WIDTH,HEIGHT`` in inches as a pair of positive floats."""
+    parts = text.replace("x", ",").split(",")
+    if len(parts) != 2:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give WIDTH,HEIGHT in inches, e.g. 12,4"
+        )
+    return tuple(_positive(part.strip()) for part in parts)
+
+
+def _add_fps(parser, help):
+    parser.add_argument("--fps", type=_positive, metavar="FPS", help=help)
+
+
+def _add_data(parser, *, with_model=False, optional=False):
     if with_model:
         parser.add_argument("model", help="model file written by `skgesture train`")
     parser.add_argument(
         "data",
+        nargs="?" if optional else None,
         help="'precog' (bundled), 'synthetic', a ChaLearn folder or zip, or a "
         "folder of your own recordings",
     )
@@ -191,8 +221,9 @@ def _add_data(parser, *, with_model=False):
     parser.add_argument(
         "--layout",
         default="kinect_v1",
-        help="skeleton layout of your recordings: kinect_v1, kinect_v2, azure, "
-        "mediapipe, msr_action3d (default kinect_v1)",
+        help="skeleton layout of your recordings (or of a live --source): "
+        "kinect_v1, kinect_v2, azure, mediapipe, msr_action3d (default "
+        "kinect_v1)",
     )
     parser.add_argument(
         "--subjects",
@@ -298,6 +329,7 @@ def build_parser():
 
     p = _subcommand(sub, "train", "train a model and write the model file")
     _add_data(p)
+    _add_fps(p, FPS_HELP + " (written to the model file)")
     _add_method(p)
     p.add_argument(
         "-o", "--output", default="model.skg", help="model file (default model.skg)"
@@ -363,20 +395,49 @@ def build_parser():
         default=DEFAULT_MAX_TIMELINES,
         help=f"timeline: sequences drawn (default {DEFAULT_MAX_TIMELINES})",
     )
+    _add_fps(p, FPS_HELP + "; the time axis is in seconds at this rate")
+    p.add_argument("--title", help="the figure's title (default: what it shows)")
+    p.add_argument(
+        "--size",
+        type=_size,
+        metavar="WIDTH,HEIGHT",
+        help="the figure's size in inches, e.g. 12,4 (default: sized to the figure)",
+    )
     p.add_argument("--dpi", type=int, default=110, help="resolution (default 110)")
     p.add_argument("--overwrite", action="store_true", help="replace the figure")
     _add_common(p)
     p.set_defaults(func=cmd_plot)
 
     p = _subcommand(
-        sub, "stream", "replay a recording frame by frame and print the events"
+        sub,
+        "stream",
+        "recognise gestures live (--source) or in a recording replayed frame by "
+        "frame, and print the events as they come",
     )
-    _add_data(p, with_model=True)
+    _add_data(p, with_model=True, optional=True)
     _add_model_loading(p)
     p.add_argument(
-        "--sequence", default="0", help="sequence index or sample id (default 0)"
+        "--source",
+        metavar="SOURCE",
+        help="a live source instead of DATA: udp://HOST:PORT (JSON datagrams; "
+        "port 0 picks a free port, printed), lsl://NAME (a Lab Streaming Layer "
+        "stream, the lsl extra) or - (CSV rows on stdin; also DATA -). Ends at "
+        "--timeout, the end of stdin, or Ctrl-C (status 0)",
     )
-    p.add_argument("--fps", type=float, help="frame rate (default: the data's)")
+    p.add_argument(
+        "--timeout",
+        type=_positive,
+        metavar="SECONDS",
+        help="udp:// and lsl://: end the stream after this many seconds without "
+        "a frame (default: wait until Ctrl-C)",
+    )
+    p.add_argument("--sequence", help="replay: sequence index or sample id (default 0)")
+    _add_fps(
+        p,
+        "frame rate: of the replayed data (default the data's), or of the live "
+        "sender (default the model's training data, else 30; lsl:// the "
+        "stream's nominal rate)",
+    )
     p.add_argument("--realtime", action="store_true", help="replay at the frame rate")
     p.add_argument(
         "--robot",
@@ -440,7 +501,9 @@ def main(argv=None):
     -------
     int
         The exit status: 0 on success, 1 for an error, 2 for a usage error,
-        130 on Ctrl-C and 141 when the reader of the output went away early
+        130 on Ctrl-C (but ``stream`` takes Ctrl-C as the end of its stream:
+        it prints the last events and the summary and returns 0) and 141
+        when the reader of the output went away early
         (``skgesture evaluate ... | head -1``), as for a program that
         SIGPIPE ends.
 

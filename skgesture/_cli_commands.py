@@ -7,8 +7,13 @@ them and ``main`` are in :mod:`skgesture._cli`.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import contextlib
+import functools
 import json
+import signal
+import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +22,7 @@ from skgesture._cli_support import (
     UsageError,
     _check_device,
     _class_name,
-    _fps,
+    _frame_rate,
     _info,
     _joints,
     _live_bars,
@@ -25,6 +30,7 @@ from skgesture._cli_support import (
     _load_model,
     _loader_verbose,
     _make_model,
+    _model_target_names,
     _n_frames,
     _parse_subjects,
     _predict,
@@ -32,6 +38,7 @@ from skgesture._cli_support import (
     _progress,
     _scores,
     _select_subjects,
+    _subset,
     _target_names,
 )
 
@@ -80,7 +87,7 @@ def cmd_train(args):
         "n_sequences": len(data.X),
         "n_frames": _n_frames(data),
         "target_names": _target_names(data),
-        "fps": _fps(data),
+        "fps": _frame_rate(args, data, kind),
         "seed": args.seed,
         "fit_seconds": round(seconds, 1),
     }
@@ -119,6 +126,41 @@ def _write_frames(path, labels, overwrite):
     return path
 
 
+def _prediction_names(data, info, y_pred):
+    """The class names the interval files are written with, or None (numbers).
+
+    The model's names (recorded when it was trained: the class names of its
+    training data, or ``"1"``, ``"2"``, ... where those were numbered) name
+    its predictions; a model file without them takes the data's. Numbers are
+    written where neither has names, or where a prediction holds a class
+    beyond the names (with a warning). ``read_intervals`` reads the files
+    back with the ``classes.txt`` written next to them.
+    """
+    data_names = _target_names(data)
+    names = _model_target_names(info) or data_names
+    if not names:
+        return None
+    if data_names and names != data_names:
+        warnings.warn(
+            f"the data name the classes {', '.join(data_names[:5])}"
+            f"{', ...' if len(data_names) > 5 else ''}, the model file "
+            f"{', '.join(names[:5])}{', ...' if len(names) > 5 else ''}; the "
+            "predictions are named by the model's",
+            UserWarning,
+            stacklevel=2,
+        )
+    top = max((int(np.max(p)) for p in y_pred if len(p)), default=0)
+    if top > len(names):
+        warnings.warn(
+            f"the model predicts class {top} but names only {len(names)} "
+            "classes; the predictions are written as class numbers",
+            UserWarning,
+            stacklevel=2,
+        )
+        return None
+    return names
+
+
 def cmd_predict(args):
     data, kind, name = _load_data(args, need_labels=False)
     model, info = _load_model(args, data)
@@ -152,14 +194,18 @@ def cmd_predict(args):
     else:
         from skgesture.datasets import write_intervals
 
-        names = _target_names(data, info)
+        names = _prediction_names(data, info, y_pred)
         if names:
             (out / "classes.txt").write_text("".join(f"{n}\n" for n in names))
         paths = []
         for path, labels in zip(targets, y_pred):
             path.parent.mkdir(parents=True, exist_ok=True)
             if fmt == "intervals":
-                paths.append(write_intervals(path, labels, overwrite=args.overwrite))
+                paths.append(
+                    write_intervals(
+                        path, labels, classes=names, overwrite=args.overwrite
+                    )
+                )
             else:
                 paths.append(_write_frames(path, labels, args.overwrite))
     from skgesture.utils._segments import labels_to_segments
@@ -209,7 +255,6 @@ def cmd_plot(args):
     if need_model and not args.model:
         raise UsageError(f"plot {kind} needs --model MODEL")
     data, data_kind, name = _load_data(args, need_labels=kind != "skeleton")
-    fps = _fps(data)
     i = _sequence_index(data, args.sequence)
     sid = str(data.sample_ids[i])
     if kind == "skeleton":
@@ -218,7 +263,7 @@ def cmd_plot(args):
         if not 0 <= frame < len(x):
             raise UsageError(f"--frame {frame}: {sid} has frames 0..{len(x) - 1}")
         ax = plotting.plot_skeleton(
-            x[frame], view=args.view, title=f"{sid}, frame {frame}"
+            x[frame], view=args.view, title=args.title or f"{sid}, frame {frame}"
         )
     else:
         model, info = _load_model(args, data)
@@ -228,9 +273,9 @@ def cmd_plot(args):
                 model,
                 data.X[i],
                 data.y[i],
-                fps=fps,
+                fps=_frame_rate(args, data, data_kind, info, i),
                 target_names=names,
-                title=f"{sid}: activity segmentation",
+                title=args.title or f"{sid}: activity segmentation",
             )
         else:
             n = len(data.X) if kind == "confusion" else args.max_sequences
@@ -238,7 +283,10 @@ def cmd_plot(args):
             y_pred = _predict(args, model, X)
             if kind == "confusion":
                 ax = plotting.plot_confusion_matrix(
-                    y, y_pred, target_names=names, title=f"frame confusions, {name}"
+                    y,
+                    y_pred,
+                    target_names=names,
+                    title=args.title or f"frame confusions, {name}",
                 )
             else:
                 ax = plotting.plot_timelines(
@@ -246,10 +294,14 @@ def cmd_plot(args):
                     y_pred,
                     sample_ids=[str(s) for s in data.sample_ids[:n]],
                     target_names=names,
-                    fps=fps,
-                    title=f"truth against prediction, {name}",
+                    fps=_frame_rate(
+                        args, _subset(data, list(range(len(X)))), data_kind, info
+                    ),
+                    title=args.title or f"truth against prediction, {name}",
                 )
     fig = ax.figure
+    if args.size:
+        fig.set_size_inches(*args.size)
     fig.tight_layout()
     output.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(output, dpi=args.dpi)
@@ -305,40 +357,217 @@ def _delay_bound(recognizer, fps):
     return wait, text
 
 
+def _parse_source(spec):
+    """``(kind, target)`` of ``--source``: ``("udp", (host, port))``,
+    ``("lsl", name)`` or ``("stdin", None)``."""
+    if spec in ("-", "stdin"):
+        return "stdin", None
+    scheme, sep, rest = spec.partition("://")
+    scheme = scheme.lower()
+    if sep and scheme == "lsl" and rest:
+        return "lsl", rest
+    if sep and scheme == "udp":
+        host, colon, port = rest.rpartition(":")
+        if colon and port.isdigit() and int(port) <= 65535:
+            return "udp", (host.strip("[]") or "127.0.0.1", int(port))
+    raise UsageError(
+        f"--source {spec!r}: give udp://HOST:PORT (e.g. udp://0.0.0.0:9000; port "
+        "0 picks a free one), lsl://NAME or - (CSV rows on stdin)"
+    )
+
+
+def _live_adapter(layout):
+    """The adapter of ``--layout`` (the names of ``--layout`` or get_adapter's)."""
+    from skgesture.datasets._skeleton_csv import LAYOUT_ALIASES
+    from skgesture.streaming import get_adapter
+
+    return get_adapter(LAYOUT_ALIASES.get(layout, layout))
+
+
+def _open_source(args, spec, fps):
+    """``(source, where)``: the live source of ``--source`` and its name."""
+    from skgesture import streaming
+
+    kind, target = _parse_source(spec)
+    adapter = _live_adapter(args.layout)
+    if kind == "stdin":
+        if args.timeout is not None:
+            raise UsageError(
+                "--timeout is for udp:// and lsl:// sources; stdin ends at the end "
+                "of its input"
+            )
+        return streaming.StdinSource(fps=fps, layout=adapter), "stdin"
+    if kind == "udp":
+        source = streaming.UDPSource(
+            *target, fps=fps, layout=adapter, timeout=args.timeout
+        )
+        host, port = source.bound_address
+        return source, f"udp://{host}:{port}"
+    source = streaming.LSLSource(
+        target, fps=args.fps, layout=adapter, timeout=args.timeout
+    )
+    return source, f"lsl://{target}"
+
+
+class _HeldInterrupt:
+    """Ctrl-C ends a stream between two frames, never inside a push.
+
+    While installed, a SIGINT that comes while a frame is pushed through the
+    recogniser sets ``pending`` (the push completes, and its events are
+    printed); one that comes elsewhere (a source waiting for data) raises
+    ``KeyboardInterrupt`` at once. The handler is only installed where
+    Python's own is (in the main thread, where Ctrl-C is not ignored).
+    """
+
+    def __init__(self):
+        self.busy = False
+        self.pending = False
+        self._previous = None
+
+    def _handle(self, signum, frame):
+        if self.busy:
+            self.pending = True
+        else:
+            raise KeyboardInterrupt
+
+    def __enter__(self):
+        try:
+            if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                self._previous = signal.signal(signal.SIGINT, self._handle)
+        except ValueError:  # not the main thread
+            self._previous = None
+        return self
+
+    def __exit__(self, *exc_info):
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+
+    @contextlib.contextmanager
+    def pushing(self):
+        self.busy = True
+        try:
+            yield
+        finally:
+            self.busy = False
+
+
+def _push_all(frames, push, report):
+    """Push every frame and report its output; ``(n_frames, interrupted)``.
+
+    Ctrl-C (``KeyboardInterrupt``) ends the loop between two frames.
+    """
+    n = 0
+    with _HeldInterrupt() as held:
+        try:
+            for frame in frames:
+                with held.pushing():
+                    out = push(frame)
+                n += 1
+                report(*out)
+                if held.pending:
+                    return n, True
+        except KeyboardInterrupt:
+            return n, True
+    return n, False
+
+
+def _paced(frames, fps):
+    """The frames of a recording, each at its time (``--realtime``)."""
+    start = time.perf_counter()
+    for t, frame in enumerate(frames):
+        lag = start + t / fps - time.perf_counter()
+        if lag > 0:
+            time.sleep(lag)
+        yield frame
+
+
+def _commander(args, recognizer, names):
+    """``(commander, robot)`` of ``--robot``, or ``(None, None)``."""
+    if not args.robot:
+        return None, None
+    from skgesture.streaming import ActionMap, GestureCommander, SimulatedRobot
+
+    mapping = _robot_mapping(args, recognizer)
+    action_map = ActionMap(
+        mapping,
+        min_confidence=args.min_confidence,
+        refractory_frames=ROBOT_REFRACTORY_FRAMES,
+    )
+    robot = SimulatedRobot()
+    for cls, command in mapping.items():
+        _info(args, f"  gesture {_class_name(cls, names)} -> {command}")
+    return GestureCommander(recognizer, action_map, robot), robot
+
+
 def cmd_stream(args):
+    """Replay DATA, or read ``--source`` live, and print the events as they come.
+
+    Both end the same way: at the end of the frames (of the recording, of
+    stdin, or ``--timeout`` seconds without a frame) or on Ctrl-C, after which
+    the recogniser is flushed, its last events printed, then the summary;
+    the status is 0 either way.
+    """
     from skgesture.streaming import StreamingRecognizer
 
-    data, _, name = _load_data(args, need_labels=False)
-    model, info = _load_model(args, data)
-    i = _sequence_index(data, args.sequence)
-    stream = np.asarray(data.X[i])
-    fps = args.fps or _fps(data) or 30.0
-    names = _target_names(data, info)
-    recognizer = StreamingRecognizer(model, target_names=names)
-    commander = robot = None
-    if args.robot:
-        from skgesture.streaming import ActionMap, GestureCommander, SimulatedRobot
-
-        mapping = _robot_mapping(args, recognizer)
-        action_map = ActionMap(
-            mapping,
-            min_confidence=args.min_confidence,
-            refractory_frames=ROBOT_REFRACTORY_FRAMES,
+    spec = args.source
+    if spec is None and args.data == "-":
+        spec = "-"
+    elif spec is not None and args.data is not None:
+        raise UsageError(f"give DATA ({args.data}) or --source {spec}, not both")
+    if spec is None and args.data is None:
+        raise UsageError(
+            "give DATA, a recording to replay, or --source udp://HOST:PORT | "
+            "lsl://NAME | - for a live stream"
         )
-        robot = SimulatedRobot()
-        commander = GestureCommander(recognizer, action_map, robot)
-        for cls, command in mapping.items():
-            _info(args, f"  gesture {_class_name(cls, names)} -> {command}")
-    print(
-        f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at {fps:g} fps"
-    )
-    print(_delay_bound(recognizer, fps)[1])
-    bar = _progress(args, range(len(stream)), "frames", unit="frame")
-    write = print
-    if not args.quiet and _live_bars():
-        from tqdm.auto import tqdm
+    if spec is not None:
+        if args.sequence is not None or args.realtime:
+            option = "--sequence" if args.sequence is not None else "--realtime"
+            raise UsageError(f"{option} is for a replayed recording, not --source")
+        from skgesture.layouts import KINECT_V1, N_COORDS
 
-        write = tqdm.write  # the events above the bar
+        # the sources' frames: Kinect v1, whatever the sender's layout
+        model, info = _load_model(args, frame_shape=(KINECT_V1.n_joints, N_COORDS))
+        fps = args.fps or (info.get("metadata") or {}).get("fps") or 30.0
+        names = _target_names(None, info)
+    else:
+        data, data_kind, name = _load_data(args, need_labels=False)
+        model, info = _load_model(args, data)
+        i = _sequence_index(data, "0" if args.sequence is None else args.sequence)
+        stream = np.asarray(data.X[i])
+        fps = _frame_rate(args, data, data_kind, info, i) or 30.0
+        names = _target_names(data, info)
+    recognizer = StreamingRecognizer(model, target_names=names)
+    commander, robot = _commander(args, recognizer, names)
+    source = bar = None
+    write = print
+    if spec is not None:
+        source, where = _open_source(args, spec, fps)
+        fps = source.fps
+        frames = source
+        write = functools.partial(print, flush=True)  # a pipe sees each event
+        ends = (
+            "the end of its input" if where == "stdin"
+            else f"{args.timeout:g} s without a frame" if args.timeout
+            else "Ctrl-C"
+        )  # fmt: skip
+        write(
+            f"streaming {where} ({source.adapter.name} layout, {fps:g} fps) until "
+            f"{ends}{'' if ends == 'Ctrl-C' else ' or Ctrl-C'}"
+        )
+    else:
+        print(
+            f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at "
+            f"{fps:g} fps"
+        )
+        bar = _progress(args, range(len(stream)), "frames", unit="frame")
+        frames = (stream[t] for t in bar)
+        if args.realtime:
+            frames = _paced(frames, fps)
+        if not args.quiet and _live_bars():
+            from tqdm.auto import tqdm
+
+            write = tqdm.write  # the events above the bar
+    write(_delay_bound(recognizer, fps)[1])
     delays = []
 
     def report(events, pairs):
@@ -359,24 +588,32 @@ def cmd_stream(args):
             else:
                 write(f"{'':>25}robot: {result.command} refused ({result.reason})")
 
-    start = time.perf_counter()
-    for t in bar:
-        if args.realtime:
-            lag = start + t / fps - time.perf_counter()
-            if lag > 0:
-                time.sleep(lag)
-        if commander is not None:
-            pairs = commander.push(stream[t])
-            report([d.event for d, _ in pairs], pairs)
-        else:
-            report(recognizer.push(stream[t]), [])
+    def push(frame):
+        if commander is None:
+            return recognizer.push(frame), []
+        pairs = commander.push(frame)
+        return [d.event for d, _ in pairs], pairs
+
+    try:
+        n, interrupted = _push_all(frames, push, report)
+    finally:
+        if source is not None and hasattr(source, "close"):
+            source.close()
+        if hasattr(bar, "close"):
+            bar.close()
+    if interrupted:
+        print(f"skgesture stream: stopped (Ctrl-C) after {n} frames", file=sys.stderr)
     if commander is not None:
         pairs = commander.flush()
         report([d.event for d, _ in pairs], pairs)
     else:
         report(recognizer.flush(), [])
-    if hasattr(bar, "close"):
-        bar.close()
+    if source is not None:
+        print(
+            f"{where}: {n} frames, {source.n_filled_} of them untracked for lost "
+            f"frames; {source.n_dropped_} bad messages skipped, "
+            f"{source.n_out_of_order_} out of order"
+        )
     summary = f"{len(delays)} events"
     if delays:
         summary += (

@@ -355,7 +355,13 @@ def _load_data(args, *, need_labels, need_skeletons=True):
                     "skgesture.datasets.load_recordings, which this installation "
                     "lacks"
                 )
-            data = load_recordings(path, layout=args.layout, verbose=verbose)
+            fps = {"fps": args.fps} if getattr(args, "fps", None) else {}
+            data = load_recordings(path, layout=args.layout, verbose=verbose, **fps)
+    if getattr(args, "fps", None):  # --fps replaces the rate the data say
+        from sklearn.utils import Bunch
+
+        data = Bunch(**data)  # a copy: a loader may cache its Bunch
+        data["fps"] = float(args.fps)
     if args.subjects:
         data = _select_subjects(data, args.subjects, name)
     if need_skeletons and data.get("X") is None:
@@ -371,11 +377,41 @@ def _n_frames(data):
     return int(sum(len(x) for x in data.X))
 
 
-def _fps(data):
-    fps = data.get("fps")
-    if fps is None or np.ndim(fps):
+def _fps(data, i=None):
+    """The data's frame rate: one number, or per sequence (ChaLearn).
+
+    Per-sequence rates give sequence ``i``'s, or their common value, or
+    None when they differ.
+    """
+    fps = None if data is None else data.get("fps")
+    if fps is None:
         return None
+    if np.ndim(fps):
+        fps = np.asarray(fps, dtype=float)
+        if i is not None:
+            return float(fps[i])
+        return float(fps[0]) if len(fps) and np.all(fps == fps[0]) else None
     return float(fps)
+
+
+def _frame_rate(args, data, kind, info=None, i=None):
+    """The frame rate of the data, for the seconds of an axis or an event.
+
+    ``--fps`` when given; else the rate the data know (ChaLearn's data
+    files, PRECOG's and the synthetic streams' nominal rates), except for
+    your own recordings, whose loader only assumes 30 fps: for them the rate
+    recorded in the model file (the training data's) comes first. None when
+    nothing knows.
+    """
+    if getattr(args, "fps", None):
+        return float(args.fps)
+    model_fps = (((info or {}).get("metadata")) or {}).get("fps")
+    if model_fps is not None and not model_fps > 0:
+        model_fps = None
+    if kind == "recordings" and model_fps:
+        return float(model_fps)
+    fps = _fps(data, i)
+    return fps if fps else (float(model_fps) if model_fps else None)
 
 
 # -- models ----------------------------------------------------------------------
@@ -506,13 +542,16 @@ def _make_model(args, verbose, joints):
     return pipe
 
 
-def _load_model(args, data=None):
-    """``(estimator, manifest)`` of the MODEL argument, checked against the data."""
+def _load_model(args, data=None, *, frame_shape=None):
+    """``(estimator, manifest)`` of the MODEL argument, checked against the
+    frames of the data (or ``frame_shape``, the shape of one frame)."""
     from skgesture._persistence import load_model, model_info
 
     path = Path(args.model).expanduser()
     info = model_info(path)
-    layout = None if data is None else tuple(np.shape(data.X[0])[1:])
+    layout = frame_shape
+    if data is not None:
+        layout = tuple(np.shape(data.X[0])[1:])
     model = load_model(
         path,
         trusted=args.trust,
@@ -525,10 +564,21 @@ def _load_model(args, data=None):
 
 
 def _target_names(data, info=None):
+    """The class names of the data, else those of the model file, else None.
+
+    Recordings read without annotations have no names (an empty list): the
+    model's, written when it was trained, name its classes then.
+    """
     names = data.get("target_names") if data is not None else None
-    if names is None and info is not None:
+    if not names and info is not None:
         names = (info.get("metadata") or {}).get("target_names")
-    return None if names is None else [str(n) for n in names]
+    return [str(n) for n in names] if names else None
+
+
+def _model_target_names(info):
+    """The class names recorded in the model file, or None."""
+    names = (info.get("metadata") or {}).get("target_names") if info else None
+    return [str(n) for n in names] if names else None
 
 
 def _min_gesture_frames(model):

@@ -9,6 +9,16 @@ the paper's: the segmentation view of its Figure 4
 Figure 7 (:func:`plot_timelines`), plus a single-sequence timeline with a score
 track (:func:`plot_gesture_timeline`) and a skeleton pose
 (:func:`plot_skeleton`). See ``docs/method.md`` for the methods they show.
+
+Every figure draws a class in the same colour. Classes 1-10 get the ten hues
+of matplotlib's ``tab10`` (the dark shades of ``tab20``), classes 11-20 the
+light shades of the same hues, classes 21-56 the colours of ``tab20b`` and
+``tab20c`` (less its greys, too close to rest), one shade of each hue in turn;
+from class 57 the colours repeat. So two classes in a row never share a hue
+(classes ``2k - 1`` and ``2k``, often the two halves of a gesture pair, are
+told apart at a glance), and the first 56 classes never share a colour. Rest
+is light grey: the background of the timeline bars, and the first entry of
+their legends.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -25,8 +35,9 @@ __all__ = [
     "plot_timelines",
 ]
 
-N_COLOURS = 20  # tab20: class k gets colour (k - 1) % 20
 REST_NAME = "rest"
+REST_COLOUR = "0.93"  # light grey: the background of a bar, where nobody gestures
+_PALETTE = []  # the class colours, filled on first use (see _class_colour)
 
 
 def _pyplot():
@@ -41,10 +52,38 @@ def _pyplot():
     return plt
 
 
-def _class_colour(label, n_colours=N_COLOURS):
-    import matplotlib as mpl
+def _palette():
+    """The 56 class colours, in the order of :func:`_class_colour`."""
+    if not _PALETTE:
+        import matplotlib as mpl
 
-    return mpl.colormaps["tab20"]((int(label) - 1) % n_colours)
+        tab20 = mpl.colormaps["tab20"].colors  # 10 hues, a dark and a light shade
+        colours = [tab20[i] for i in range(0, 20, 2)]  # the dark ones (tab10)
+        colours += [tab20[i] for i in range(1, 20, 2)]  # then the light ones
+        # 5 hues of 4 shades each; tab20c's fifth hue is grey, too close to rest
+        for name, n_hues in (("tab20b", 5), ("tab20c", 4)):
+            shades = mpl.colormaps[name].colors
+            for shade in (0, 2, 1, 3):
+                colours += [shades[4 * hue + shade] for hue in range(n_hues)]
+        _PALETTE.extend(tuple(c) for c in colours)
+    return _PALETTE
+
+
+def _class_colour(label):
+    """The colour of class ``label`` (an RGB tuple); rest is light grey.
+
+    Classes 1-10 get the ten hues of tab10 (the dark shades of tab20), classes
+    11-20 the light shades of the same hues, classes 21-56 the colours of
+    tab20b and tab20c (less its greys), one shade of each hue in turn; from
+    class 57 the colours repeat. Two classes in a row (``2k - 1`` and ``2k``
+    above all, often the two halves of a gesture pair) never share a hue, and
+    the first 56 classes never share a colour.
+    """
+    label = int(label)
+    if label == 0:
+        return REST_COLOUR
+    palette = _palette()
+    return palette[(label - 1) % len(palette)]
 
 
 def _class_name(label, target_names):
@@ -77,12 +116,15 @@ def plot_gesture_timeline(
     target_names=None,
     ax=None,
     title=None,
+    legend=True,
 ):
     """Draw the gestures of one sequence as coloured bars, truth above prediction.
 
-    Every maximal run of one class is a bar named after its class; a score
-    track (such as the segmenter's smoothed score) and its threshold can be
-    drawn underneath.
+    Every maximal run of one class is a bar named after its class, on a light
+    grey band that is rest; a score track (such as the segmenter's smoothed
+    score) and its threshold can be drawn underneath. The legend names rest
+    and every class present, in the class colours of the module docstring
+    (classes ``2k - 1`` and ``2k`` never share a hue).
 
     Parameters
     ----------
@@ -103,6 +145,8 @@ def plot_gesture_timeline(
         Where to draw; a new figure when None.
     title : str or None, default=None
         Axes title.
+    legend : bool, default=True
+        Show a legend: rest, the classes present, and the score track.
 
     Returns
     -------
@@ -119,11 +163,16 @@ def plot_gesture_timeline(
     >>> import matplotlib
     >>> matplotlib.use("Agg")
     >>> from skgesture.plotting import plot_gesture_timeline
-    >>> ax = plot_gesture_timeline([0, 1, 1, 0, 2, 2], [0, 1, 1, 1, 0, 2])
+    >>> ax = plot_gesture_timeline([0, 1, 1, 0, 2, 2], [0, 1, 1, 1, 0, 2],
+    ...                            target_names=["wave", "point"])
     >>> [t.get_text() for t in ax.get_yticklabels()]
     ['prediction', 'truth']
+    >>> [t.get_text() for t in ax.get_legend().get_texts()]
+    ['rest', 'wave', 'point']
     """
     plt = _pyplot()
+    from matplotlib.patches import Patch, Rectangle
+
     rows = [
         (name, _labels(y, name_arg))
         for name, name_arg, y in (
@@ -138,9 +187,21 @@ def plot_gesture_timeline(
         _, ax = plt.subplots(figsize=(12, 1.2 + 0.6 * max(len(rows), 1)))
     scale = 1.0 / fps if fps else 1.0
     top = len(rows)
+    present = set()
     for level, (name, y) in enumerate(rows):
         row = top - level  # truth on top
+        ax.add_patch(
+            Rectangle(
+                (0, row - 0.4),
+                len(y) * scale,
+                0.8,
+                facecolor=REST_COLOUR,
+                linewidth=0,
+                zorder=0.5,
+            )
+        )
         for c, s, e in labels_to_segments(y):
+            present.add(int(c))
             ax.broken_barh(
                 [(s * scale, (e - s) * scale)],
                 (row - 0.4, 0.8),
@@ -160,23 +221,41 @@ def plot_gesture_timeline(
     ticks = [top - level for level in range(len(rows))]
     ax.set_yticks(ticks[::-1], [name for name, _ in rows][::-1])
     n_frames = max([len(y) for _, y in rows] + [0])
+    handles = []
+    if rows:
+        handles.append(Patch(facecolor=REST_COLOUR, label=REST_NAME))
+        handles += [
+            Patch(facecolor=_class_colour(c), label=_class_name(c, target_names))
+            for c in sorted(present)
+        ]
     if scores is not None:
         s = np.asarray(scores, dtype=float)
         n_frames = max(n_frames, len(s))
         t = np.arange(len(s)) * scale
-        ax.plot(t, s * 0.8 - 0.4, color="tab:gray", linewidth=1, label="score (0-1)")
+        handles += ax.plot(
+            t, s * 0.8 - 0.4, color="tab:gray", linewidth=1, label="score (0-1)"
+        )
         if threshold is not None:
-            ax.axhline(
-                threshold * 0.8 - 0.4,
-                color="tab:red",
-                linestyle="--",
-                linewidth=0.8,
-                label=f"threshold {threshold}",
+            handles.append(
+                ax.axhline(
+                    threshold * 0.8 - 0.4,
+                    color="tab:red",
+                    linestyle="--",
+                    linewidth=0.8,
+                    label=f"threshold {threshold}",
+                )
             )
-        ax.legend(loc="upper right", fontsize=7)
         ax.set_ylim(-0.5, top + 0.5)
     else:
         ax.set_ylim(0.5, top + 0.5)
+    if legend and handles:
+        ax.legend(
+            handles=handles,
+            loc="upper left",
+            bbox_to_anchor=(1.01, 1.0),
+            fontsize=7,
+            frameon=False,
+        )
     if n_frames:
         ax.set_xlim(0, n_frames * scale)
     ax.set_xlabel("time (s)" if fps else "frame")
@@ -219,7 +298,9 @@ def plot_timelines(
     title : str or None, default=None
         Axes title.
     legend : bool, default=True
-        Show a legend of the classes present.
+        Show a legend: rest (the grey background of a bar) and the classes
+        present, in the class colours of the module docstring (classes
+        ``2k - 1`` and ``2k`` never share a hue).
 
     Returns
     -------
@@ -242,8 +323,8 @@ def plot_timelines(
     ...                     target_names=["wave", "point", "stop"])
     >>> [t.get_text() for t in ax.get_yticklabels()]
     ['take2', 'take1']
-    >>> sorted(t.get_text() for t in ax.get_legend().get_texts())
-    ['point', 'stop', 'wave']
+    >>> [t.get_text() for t in ax.get_legend().get_texts()]
+    ['rest', 'wave', 'point', 'stop']
     """
     plt = _pyplot()
     y_true = [_labels(y, f"y_true[{i}]") for i, y in enumerate(y_true)]
@@ -273,7 +354,10 @@ def plot_timelines(
             tracks.append((y_pred[i], centre - 0.02 - bar))
         for y, bottom in tracks:
             ax.broken_barh(
-                [(0, len(y) * scale)], (bottom, bar), facecolors="0.93", linewidth=0
+                [(0, len(y) * scale)],
+                (bottom, bar),
+                facecolors=REST_COLOUR,
+                linewidth=0,
             )
             for c, s, e in labels_to_segments(y):
                 present.add(int(c))
@@ -292,10 +376,10 @@ def plot_timelines(
     ax.set_xlabel("time (s)" if fps else "frame")
     if y_pred is not None:
         ax.set_ylabel("upper bar: truth, lower bar: prediction", fontsize=8)
-    if legend and present:
+    if legend:
         from matplotlib.patches import Patch
 
-        handles = [
+        handles = [Patch(facecolor=REST_COLOUR, label=REST_NAME)] + [
             Patch(facecolor=_class_colour(c), label=_class_name(c, target_names))
             for c in sorted(present)
         ]

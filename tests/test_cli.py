@@ -3,10 +3,15 @@
 import io
 import json
 import os
+import queue
 import re
 import shutil
+import signal
+import socket
+import struct
 import subprocess
 import sys
+import threading
 import zipfile
 from pathlib import Path
 
@@ -389,8 +394,11 @@ def test_predict_intervals_read_back(model_b, held_out, tmp_path, capsys):
 
     pred = load_model(model_b).predict(held_out.X)
     for sid, p in zip(held_out.sample_ids, pred):
-        rows = read_intervals(out_dir / f"{sid}.labels.csv")
+        path = out_dir / f"{sid}.labels.csv"
+        rows = read_intervals(path, classes=out_dir / "classes.txt")
         assert_array_equal(np.asarray(rows).reshape(-1, 3), labels_to_segments(p))
+        if len(p.nonzero()[0]):  # the model's class names, as the data name them
+            assert "gesture_0" in path.read_text()
     assert (out_dir / "classes.txt").read_text().split() == [
         "gesture_01",
         "gesture_02",
@@ -422,33 +430,60 @@ def test_predict_frames(model_b, held_out, tmp_path, capsys):
     assert_array_equal(table[:, 1], pred[0])
 
 
-def test_round_trip_on_own_recordings(tmp_path, capsys):
-    # A folder of the user's own recordings: one CSV per take, its intervals
-    # next to it, class names in classes.txt.
-    from skgesture.datasets import write_intervals
+def test_round_trip_on_own_recordings(tmp_path, capsys, monkeypatch):
+    """A folder of the user's own recordings (20 fps): one CSV per take, its
+    intervals next to it labelled by class names, the names in classes.txt.
+    --fps reaches the model file and, from it, the figures; predictions on
+    new takes (no annotations) are written with the names and read back."""
+    from skgesture._persistence import model_info
+    from skgesture.datasets import read_intervals, write_intervals
 
     data = make_gesture_streams(n_sequences=4, n_classes=3, random_state=3)
-    folder = tmp_path / "takes"
+    names = ["wave", "point", "stop"]
+    folder, new_takes = tmp_path / "takes", tmp_path / "new"
     folder.mkdir()
+    new_takes.mkdir()
     for k, (x, y) in enumerate(zip(data.X, data.y)):
         np.savetxt(folder / f"take{k}.csv", x.reshape(len(x), -1), delimiter=",")
-        write_intervals(folder / f"take{k}.labels.csv", y)
+        write_intervals(folder / f"take{k}.labels.csv", y, classes=names)
+        shutil.copy(folder / f"take{k}.csv", new_takes / f"take{k}.csv")
     (folder / "classes.txt").write_text("wave\npoint\nstop\n")
     model = tmp_path / "own.skg"
     with torch.random.fork_rng(devices=[]):
-        status, out, err = run(["train", folder, *TINY, "-o", model], capsys)
+        status, out, err = run(
+            ["train", folder, "--fps", "20", *TINY, "-o", model], capsys
+        )
     assert status == 0, err
+    assert model_info(model)["metadata"]["fps"] == 20.0  # not the loader's 30
     status, out, err = run(["evaluate", model, folder, "--json", "-q"], capsys)
     assert status == 0, err
-    names = [row["name"] for row in json.loads(out)["per_class"]]
-    assert names == ["rest", "wave", "point", "stop"]
-    status, out, err = run(
-        ["predict", model, folder, "-o", tmp_path / "p", "-q"], capsys
+    names_out = [row["name"] for row in json.loads(out)["per_class"]]
+    assert names_out == ["rest", "wave", "point", "stop"]
+    saved = _savefig_spy(monkeypatch)
+    status, _, err = run(
+        ["plot", "timeline", folder, "--model", model, "-o", tmp_path / "t.png"],
+        capsys,
     )
     assert status == 0, err
-    assert sorted(p.name for p in (tmp_path / "p").glob("*.labels.csv")) == [
+    n_frames = max(len(x) for x in data.X)
+    assert saved[-1].axes[0].get_xlim()[1] == pytest.approx(n_frames / 20)
+    status, out, err = run(
+        ["predict", model, new_takes, "-o", tmp_path / "p", "-q"], capsys
+    )
+    assert status == 0, err
+    pred_dir = tmp_path / "p"
+    assert sorted(p.name for p in pred_dir.glob("*.labels.csv")) == [
         f"take{k}.labels.csv" for k in range(4)
     ]
+    assert (pred_dir / "classes.txt").read_text().split() == names
+    pred = load_model(model).predict(data.X)
+    assert any(len(labels_to_segments(p)) for p in pred)
+    for k, p in enumerate(pred):
+        path = pred_dir / f"take{k}.labels.csv"
+        labels = [line.rsplit(",", 1)[1] for line in path.read_text().split()[1:]]
+        assert set(labels) <= set(names)  # names, as the input had
+        rows = read_intervals(path, classes=pred_dir / "classes.txt")
+        assert_array_equal(rows, labels_to_segments(p))
 
 
 @pytest.mark.slow
@@ -711,6 +746,213 @@ def test_stream_drives_the_robot(model_b, capsys):
         ["stream", model_b, *HELD_OUT, "--robot", "--commands", "1,2", "-q"], capsys
     )
     _assert_one_line_error(status, err, "needs 5 gesture classes")
+
+
+def _event_lines(out):
+    """The event lines and the closing summary of ``skgesture stream``."""
+    lines = out.splitlines()
+    events = [line for line in lines if "delay" in line and "frame " in line]
+    summary = [line for line in lines if re.match(r"\d+ events", line)]
+    return events, summary
+
+
+def _csv_rows(frames):
+    """One CSV row per frame, exact (``repr`` of each float; NaN as ``nan``)."""
+    return [",".join(map(repr, f.ravel().tolist())) + "\n" for f in frames]
+
+
+SOCKET_TIMEOUT = 5.0  # seconds, every socket and thread of the live tests
+
+
+def test_stream_live_udp_gives_the_events_of_replay(
+    model_b, held_out, capsys, monkeypatch
+):
+    """``stream --source udp://127.0.0.1:0`` with a sender thread on 127.0.0.1
+    sending sequence 0 as JSON datagrams prints the events of the replay of the
+    same frames. Port 0: the source binds a free port (the CLI prints it); the
+    test learns it from the UDPSource the CLI makes. At most 32 datagrams in
+    flight, so that loopback drops none."""
+    from skgesture import streaming
+
+    status, out, err = run(["stream", model_b, *HELD_OUT, "-q"], capsys)
+    assert status == 0, err
+    replay_events, replay_summary = _event_lines(out)
+    assert replay_events
+
+    made, window, sources = queue.Queue(), threading.Semaphore(32), []
+
+    class Recorded(streaming.UDPSource):
+        def __init__(self, *a, **k):
+            super().__init__(*a, **k)
+            sources.append(self)
+            made.put(self)
+
+        def frames(self):
+            for frame in super().frames():
+                yield frame
+                window.release()
+
+    monkeypatch.setattr(streaming, "UDPSource", Recorded)
+    frames = held_out.X[0]
+    failures = []
+
+    def send():
+        try:
+            address = made.get(timeout=SOCKET_TIMEOUT).bound_address
+            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+                sock.settimeout(SOCKET_TIMEOUT)
+                for k, frame in enumerate(frames):
+                    if not window.acquire(timeout=SOCKET_TIMEOUT):
+                        raise TimeoutError("the receiver stopped reading")
+                    message = {"t": k / held_out.fps}
+                    if np.isfinite(frame).all() and frame.any():
+                        message["joints"] = frame.tolist()
+                    else:
+                        message["tracked"] = False
+                    sock.sendto(json.dumps(message).encode(), address)
+        except Exception as exc:  # reported by the test, not lost in the thread
+            failures.append(exc)
+
+    thread = threading.Thread(target=send, daemon=True)
+    thread.start()
+    argv = ["stream", model_b, "--source", "udp://127.0.0.1:0", "--timeout", "0.5"]
+    status, out, err = run(argv + ["-q"], capsys)
+    thread.join(SOCKET_TIMEOUT)
+    assert not thread.is_alive() and not failures, failures
+    assert status == 0, err
+    port = sources[0].bound_address[1]
+    assert out.startswith(f"streaming udp://127.0.0.1:{port} (kinect_v1 layout, 20")
+    assert _event_lines(out) == (replay_events, replay_summary)
+    assert f"{len(frames)} frames, 0 of them untracked" in out
+
+
+def test_stream_live_stdin_gives_the_events_of_replay(
+    model_b, held_out, capsys, monkeypatch
+):
+    """CSV rows on stdin (``--source -``, or DATA ``-``) until its end."""
+    status, out, err = run(["stream", model_b, *HELD_OUT, "--sequence", "1"], capsys)
+    assert status == 0, err
+    replay = _event_lines(out)
+    assert replay[0]
+    rows = ["# x, y, z of the 20 Kinect v1 joints\n", *_csv_rows(held_out.X[1])]
+    for argv in (["--source", "-"], ["-"]):
+        monkeypatch.setattr(sys, "stdin", io.StringIO("".join(rows)))
+        status, out, err = run(["stream", model_b, *argv, "-q"], capsys)
+        assert status == 0, err
+        assert out.startswith("streaming stdin (kinect_v1 layout, 20 fps) until the")
+        assert _event_lines(out) == replay
+        assert out.splitlines()[-1] == replay[1][0]  # the summary comes last
+
+
+class _Interrupted:
+    """Lines of a text stream, then Ctrl-C (``KeyboardInterrupt``)."""
+
+    def __init__(self, lines):
+        self.lines = lines
+
+    def __iter__(self):
+        yield from self.lines
+        raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("where", ["waiting for a frame", "inside a push"])
+def test_stream_ctrl_c_flushes_and_prints_the_summary(
+    model_b, held_out, capsys, monkeypatch, where
+):
+    """Ctrl-C ends a live stream cleanly, status 0: the frames pushed so far
+    are flushed (a Ctrl-C inside a push waits for the push to finish), their
+    events printed, then the summary."""
+    from skgesture.streaming import StreamingRecognizer
+
+    frames, k = held_out.X[0], 900
+    if where == "waiting for a frame":
+        stdin, n = _Interrupted(_csv_rows(frames[:k])), k
+    else:
+        stdin, n, pushed = io.StringIO("".join(_csv_rows(frames))), k + 1, [0]
+        real_push = StreamingRecognizer.push
+
+        def push(self, frame):
+            if pushed[0] == k:
+                signal.raise_signal(signal.SIGINT)  # Ctrl-C, during push k
+            pushed[0] += 1
+            return real_push(self, frame)
+
+        monkeypatch.setattr(StreamingRecognizer, "push", push)
+    monkeypatch.setattr(sys, "stdin", stdin)
+    status, out, err = run(["stream", model_b, "-", "-q"], capsys)
+    assert status == 0, err
+    assert f"stopped (Ctrl-C) after {n} frames" in err
+    monkeypatch.undo()
+    expected = StreamingRecognizer(load_model(model_b)).recognize(frames[:n])
+    events, summary = _event_lines(out)
+    assert expected and len(events) == len(expected)
+    for line, ev in zip(events, expected):
+        assert f"frame {ev.emitted_at:6d}" in line and f"delay {ev.delay} " in line
+    assert summary and summary[0].startswith(f"{len(expected)} events")
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["--source", "tcp://127.0.0.1:9000"], "give udp://HOST:PORT"),
+        (["--source", "udp://127.0.0.1"], "give udp://HOST:PORT"),
+        (["--source", "udp://127.0.0.1:99999"], "give udp://HOST:PORT"),
+        (["synthetic", "--source", "-"], "not both"),
+        ([], "give DATA"),
+        (["--source", "-", "--timeout", "1"], "stdin ends at the end of its input"),
+        (["--source", "-", "--sequence", "2"], "--sequence is for a replayed"),
+        (["--source", "udp://127.0.0.1:0", "--layout", "kinect3"], "unknown layout"),
+    ],
+)
+def test_stream_source_mistakes_are_one_line(model_b, capsys, argv, match):
+    status, _, err = run(["stream", model_b, *argv, "-q"], capsys)
+    _assert_one_line_error(status, err, match)
+
+
+def _savefig_spy(monkeypatch):
+    """The figures that ``savefig`` writes, kept for the test to look at."""
+    from matplotlib.figure import Figure
+
+    saved, real = [], Figure.savefig
+
+    def savefig(self, *args, **kwargs):
+        saved.append(self)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    return saved
+
+
+def test_plot_title_size_and_fps_reach_the_figure(
+    model_b, tmp_path, capsys, monkeypatch
+):
+    pytest.importorskip("matplotlib")
+    saved = _savefig_spy(monkeypatch)
+    n_frames = max(len(x) for x in make_gesture_streams(2, 3, random_state=1).X)
+    base = ["plot", "timeline", *HELD_OUT, "--model", model_b, "-q", "--overwrite"]
+    path = tmp_path / "t.png"
+    status, _, err = run(base + ["-o", path], capsys)
+    assert status == 0, err
+    ax = saved[-1].axes[0]
+    assert ax.get_xlabel() == "time (s)"
+    assert ax.get_xlim()[1] == pytest.approx(n_frames / 20)  # the data's 20 fps
+    assert ax.get_title().startswith("truth against prediction")
+    argv = base + ["-o", path, "--fps", "10", "--title", "Take 3", "--size", "8,3"]
+    status, _, err = run(argv + ["--dpi", "50"], capsys)
+    assert status == 0, err
+    fig = saved[-1]
+    ax = fig.axes[0]
+    assert ax.get_xlim()[1] == pytest.approx(n_frames / 10)
+    assert ax.get_title() == "Take 3"
+    assert tuple(fig.get_size_inches()) == (8, 3)
+    png = path.read_bytes()
+    assert struct.unpack(">II", png[16:24]) == (400, 150)  # 8 x 3 inches at 50 dpi
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend[0] == "rest" and "gesture_01" in legend
+    for bad in (["--size", "8"], ["--size", "8,-1"], ["--fps", "0"]):
+        status, _, err = run(base + ["-o", path, *bad], capsys)
+        assert status == 2 and bad[0] in err
 
 
 @pytest.mark.slow

@@ -11,13 +11,14 @@ matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.colors import LogNorm  # noqa: E402
+from matplotlib.colors import LogNorm, rgb_to_hsv, to_rgb  # noqa: E402
 from sklearn.linear_model import LogisticRegression  # noqa: E402
 
 from skgesture import make_method_a  # noqa: E402
 from skgesture.datasets import make_gesture_streams  # noqa: E402
 from skgesture.layouts import KINECT_V1  # noqa: E402
 from skgesture.plotting import (  # noqa: E402
+    _class_colour,
     plot_confusion_matrix,
     plot_gesture_timeline,
     plot_segmentation,
@@ -90,6 +91,58 @@ def test_gesture_timeline_bars_follow_the_labels():
         plot_gesture_timeline()
 
 
+def _legend(ax):
+    """``{label: facecolour}`` of the legend's patches, in legend order."""
+    leg = ax.get_legend()
+    return {
+        t.get_text(): to_rgb(h.get_facecolor())
+        for t, h in zip(leg.get_texts(), leg.legend_handles)
+        if hasattr(h, "get_facecolor")
+    }
+
+
+def test_gesture_timeline_legend_names_rest_and_the_classes_present():
+    names = ["wave", "point", "stop", "kick"]
+    ax = plot_gesture_timeline(
+        [0, 1, 1, 0, 2, 2, 0], [0, 1, 1, 1, 0, 4, 0], target_names=names
+    )
+    legend = _legend(ax)
+    assert list(legend) == ["rest", "wave", "point", "kick"]  # not "stop": absent
+    assert legend["rest"] == to_rgb("0.93")
+    for k, name in ((1, "wave"), (2, "point"), (4, "kick")):
+        assert legend[name] == to_rgb(_class_colour(k))
+    # the bars are drawn in the legend's colours
+    bar_colours = {to_rgb(c.get_facecolor()[0]) for c in ax.collections}
+    assert bar_colours == {legend[n] for n in ("wave", "point", "kick")}
+    # with a score track the legend lists the curves after the classes
+    ax = plot_gesture_timeline([0, 1, 1, 0], scores=[0, 0.9, 0.8, 0.1], threshold=0.5)
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert texts == ["rest", "1", "score (0-1)", "threshold 0.5"]
+    assert plot_gesture_timeline([0, 1, 1], legend=False).get_legend() is None
+
+
+@pytest.mark.parametrize("n_classes", [20, 56])
+def test_no_two_classes_share_a_colour_and_neighbours_differ_in_hue(n_classes):
+    """Classes 2k - 1 and 2k (any two in a row) differ in hue, not only in
+    shade (tab20 in its own order gave them a dark and a light blue)."""
+    colours = [to_rgb(_class_colour(k)) for k in range(1, n_classes + 1)]
+    assert len(set(colours)) == n_classes
+    assert to_rgb(_class_colour(0)) not in colours  # rest
+    hsv = rgb_to_hsv(np.array(colours))
+    for k in range(n_classes - 1):
+        (h1, s1, v1), (h2, s2, v2) = hsv[k], hsv[k + 1]
+        if min(s1, s2) < 0.05:  # a grey: told apart by saturation or value
+            assert max(abs(s1 - s2), abs(v1 - v2)) >= 0.2, (k + 1, k + 2)
+        else:
+            dh = abs(h1 - h2)
+            assert min(dh, 1 - dh) * 360 >= 20, (k + 1, k + 2)
+    # the timelines draw the same colours, each class in its own
+    y = [np.repeat(np.arange(n_classes + 1), 3)]
+    ax = plot_timelines(y)
+    legend = _legend(ax)
+    assert len(legend) == n_classes + 1 and len(set(legend.values())) == n_classes + 1
+
+
 def test_timelines_one_band_per_sequence():
     y_true = [[0, 1, 1, 0, 0], [0, 0, 2, 2, 2, 0, 3]]
     y_pred = [[0, 1, 1, 1, 0], [0, 0, 0, 2, 2, 0, 0]]
@@ -100,7 +153,8 @@ def test_timelines_one_band_per_sequence():
     assert len(gestures) == sum(
         len(labels_to_segments(np.asarray(y))) for y in y_true + y_pred
     )
-    assert sorted(t.get_text() for t in ax.get_legend().get_texts()) == ["x", "y", "z"]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend == ["rest", "x", "y", "z"]
     with pytest.raises(ValueError, match="y_pred\\[1\\] has 3 frames"):
         plot_timelines(y_true, [y_pred[0], [0, 0, 0]])
     with pytest.raises(ValueError, match="2 sequences but y_pred has 1"):
