@@ -446,14 +446,24 @@ def build_parser():
     )
     p.add_argument(
         "--commands",
-        help="--robot: the 5 gesture classes giving move_to_tool, close_gripper, "
-        "carry_tool, open_gripper, return_home (default the first 5 classes)",
+        help="a command file (.json or .toml: any gestures, by name or number, to "
+        "any commands, with an optional state machine; docs/streaming.md, 'Command "
+        "files'), or with --robot the 5 distinct gesture classes giving "
+        "move_to_tool, close_gripper, carry_tool, open_gripper, return_home "
+        "(default the first 5 classes)",
+    )
+    p.add_argument(
+        "--publish",
+        action="append",
+        metavar="TARGET",
+        help="publish each command as JSON: 'stdout' (JSON lines; the event lines "
+        "then go to stderr) or udp://HOST:PORT (one datagram each); repeatable",
     )
     p.add_argument(
         "--min-confidence",
         type=float,
         default=0.5,
-        help="--robot: confidence floor of a command (default 0.5)",
+        help="confidence floor of a command (default 0.5)",
     )
     _add_common(p)
     p.set_defaults(func=cmd_stream)

@@ -311,19 +311,68 @@ def cmd_plot(args):
 
 
 def _robot_mapping(args, recognizer):
+    """``{class: RobotCommand}`` of ``--robot``: ``--commands`` as 5 distinct
+    classes of the model, one per command in task order, or the first 5."""
     from skgesture.streaming import RobotCommand
 
     commands = list(RobotCommand)
+    classes = [int(c) for c in recognizer.classes_ if c != 0]
     if args.commands:
-        classes = [int(c) for c in _parse_subjects(args.commands)]
-    else:
-        classes = [int(c) for c in recognizer.classes_ if c != 0][: len(commands)]
-    if len(classes) != len(commands):
+        given = [int(c) for c in _parse_subjects(args.commands)]
+        if len(given) != len(commands):
+            raise UsageError(
+                f"--commands needs {len(commands)} gesture classes (one per command: "
+                f"{', '.join(map(str, commands))}), got {len(given)}"
+            )
+        twice = sorted({c for c in given if given.count(c) > 1})
+        if twice:
+            raise UsageError(
+                f"--commands {args.commands}: class {twice[0]} is given twice; each "
+                f"command needs its own gesture"
+            )
+        unknown = [c for c in given if c not in classes]
+        if unknown:
+            raise UsageError(
+                f"--commands {args.commands}: class {unknown[0]} is not a class of "
+                f"the model (its classes are {', '.join(map(str, classes))})"
+            )
+        classes = given
+    elif len(classes) < len(commands):
         raise UsageError(
-            f"--commands needs {len(commands)} gesture classes (one per command: "
-            f"{', '.join(map(str, commands))}), got {len(classes)}"
+            f"--robot needs {len(commands)} gesture classes (one per command), the "
+            f"model has {len(classes)}; give a command file with --commands FILE"
         )
-    return dict(zip(classes, commands))
+    return dict(zip(classes, commands[: len(classes)]))
+
+
+def _command_file(spec):
+    """The path of ``--commands`` when it names a command file, else None."""
+    if spec and (
+        Path(spec).suffix.lower() in (".json", ".toml") or Path(spec).is_file()
+    ):
+        return Path(spec)
+    return None
+
+
+def _publishers(args):
+    """The ``on_command`` callbacks of ``--publish`` (stdout, udp://HOST:PORT)."""
+    from skgesture.streaming import JSONLinesPublisher, UDPPublisher
+
+    out = []
+    for target in args.publish or ():
+        if target == "stdout":
+            out.append(JSONLinesPublisher(sys.stdout))
+        elif target.startswith("udp://"):
+            host, _, port = target[len("udp://") :].rpartition(":")
+            if not host or not port.isdigit() or not 0 < int(port) < 65536:
+                raise UsageError(
+                    f"--publish {target}: expected udp://HOST:PORT, e.g. "
+                    f"udp://127.0.0.1:9001"
+                )
+            out.append(UDPPublisher(host, int(port)))
+        else:
+            raise UsageError(f"--publish {target}: expected stdout or udp://HOST:PORT")
+    return out
 
 
 def _delay_bound(recognizer, fps):
@@ -481,22 +530,42 @@ def _paced(frames, fps):
         yield frame
 
 
-def _commander(args, recognizer, names):
-    """``(commander, robot)`` of ``--robot``, or ``(None, None)``."""
-    if not args.robot:
+def _commander(args, recognizer, names, fps):
+    """``(commander, robot)`` of ``--robot``/``--commands FILE``/``--publish``,
+    or ``(None, None)`` when the events drive nothing."""
+    path = _command_file(args.commands)
+    if not (args.robot or path or args.publish):
         return None, None
-    from skgesture.streaming import ActionMap, GestureCommander, SimulatedRobot
+    from skgesture.streaming import (
+        ActionMap,
+        CommandMap,
+        GestureCommander,
+        SimulatedRobot,
+    )
 
-    mapping = _robot_mapping(args, recognizer)
+    if path is not None:
+        try:
+            mapping = CommandMap.from_file(path)
+        except FileNotFoundError:
+            raise UsageError(f"--commands {path}: no such file") from None
+    elif args.robot or args.commands:
+        mapping = CommandMap(
+            {str(c): str(cmd) for c, cmd in _robot_mapping(args, recognizer).items()}
+        )
+    else:
+        raise UsageError("--publish needs --robot or a command file (--commands FILE)")
     action_map = ActionMap(
         mapping,
         min_confidence=args.min_confidence,
         refractory_frames=ROBOT_REFRACTORY_FRAMES,
     )
-    robot = SimulatedRobot()
-    for cls, command in mapping.items():
+    robot = SimulatedRobot() if args.robot else None
+    commander = GestureCommander(
+        recognizer, action_map, robot, on_command=_publishers(args) or None, fps=fps
+    )
+    for cls, command in commander.command_map.mapping.items():
         _info(args, f"  gesture {_class_name(cls, names)} -> {command}")
-    return GestureCommander(recognizer, action_map, robot), robot
+    return commander, robot
 
 
 def cmd_stream(args):
@@ -537,14 +606,16 @@ def cmd_stream(args):
         fps = _frame_rate(args, data, data_kind, info, i) or 30.0
         names = _target_names(data, info)
     recognizer = StreamingRecognizer(model, target_names=names)
-    commander, robot = _commander(args, recognizer, names)
+    commander, robot = _commander(args, recognizer, names, fps)
     source = bar = None
-    write = print
+    # With --publish stdout, stdout carries only the commands' JSON lines.
+    human = sys.stderr if "stdout" in (args.publish or ()) else sys.stdout
+    write = functools.partial(print, file=human)
     if spec is not None:
         source, where = _open_source(args, spec, fps)
         fps = source.fps
         frames = source
-        write = functools.partial(print, flush=True)  # a pipe sees each event
+        write = functools.partial(print, file=human, flush=True)  # a pipe sees each
         ends = (
             "the end of its input" if where == "stdin"
             else f"{args.timeout:g} s without a frame" if args.timeout
@@ -555,7 +626,7 @@ def cmd_stream(args):
             f"{ends}{'' if ends == 'Ctrl-C' else ' or Ctrl-C'}"
         )
     else:
-        print(
+        write(
             f"streaming {data.sample_ids[i]} of {name}: {len(stream)} frames at "
             f"{fps:g} fps"
         )
@@ -563,7 +634,7 @@ def cmd_stream(args):
         frames = (stream[t] for t in bar)
         if args.realtime:
             frames = _paced(frames, fps)
-        if not args.quiet and _live_bars():
+        if not args.quiet and _live_bars() and human is sys.stdout:
             from tqdm.auto import tqdm
 
             write = tqdm.write  # the events above the bar
@@ -580,13 +651,14 @@ def cmd_stream(args):
                 f"{ev.confidence:.2f}  delay {ev.delay} frames "
                 f"({ev.delay / fps:.2f} s)"
             )
+        who = "robot" if robot is not None else "command"
         for decision, result in pairs:
             if result is None:
-                write(f"{'':>25}robot: ignored ({decision.reason})")
+                write(f"{'':>25}{who}: ignored ({decision.reason})")
             elif result.accepted:
-                write(f"{'':>25}robot: {result.command} -> {result.state_after}")
+                write(f"{'':>25}{who}: {result.command} -> {result.state_after}")
             else:
-                write(f"{'':>25}robot: {result.command} refused ({result.reason})")
+                write(f"{'':>25}{who}: {result.command} refused ({result.reason})")
 
     def push(frame):
         if commander is None:
@@ -609,7 +681,7 @@ def cmd_stream(args):
     else:
         report(recognizer.flush(), [])
     if source is not None:
-        print(
+        write(
             f"{where}: {n} frames, {source.n_filled_} of them untracked for lost "
             f"frames; {source.n_dropped_} bad messages skipped, "
             f"{source.n_out_of_order_} out of order"
@@ -620,9 +692,9 @@ def cmd_stream(args):
             f"; delay mean {np.mean(delays):.1f}, max {max(delays)} frames "
             f"({max(delays) / fps:.2f} s)"
         )
-    print(summary)
+    write(summary)
     if robot is not None:
-        print(f"robot: {robot.status()}")
+        write(f"robot: {robot.status()}")
     return 0
 
 

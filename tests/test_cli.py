@@ -735,17 +735,45 @@ def test_stream_delays_are_within_the_printed_bound(model_b, capsys):
     assert "first 55 frames of a longer activity period" in out
 
 
-def test_stream_drives_the_robot(model_b, capsys):
-    status, out, err = run(
-        ["stream", model_b, *HELD_OUT, "--robot", "--commands", "1,2,3,1,2", "-q"],
-        capsys,
-    )
+def test_stream_drives_the_robot(model_b, tmp_path, capsys):
+    # The model has 3 classes: a command file gives them 3 of the robot's commands.
+    commands = tmp_path / "robot.json"
+    commands.write_text(json.dumps({"commands": {
+        "1": "move_to_tool", "2": "close_gripper", "3": "carry_tool"}}))  # fmt: skip
+    base = ["stream", model_b, *HELD_OUT, "--robot", "-q"]
+    status, out, err = run([*base, "--commands", commands], capsys)
     assert status == 0, err
     assert "robot:" in out and out.splitlines()[-1].startswith("robot: ")
-    status, _, err = run(
-        ["stream", model_b, *HELD_OUT, "--robot", "--commands", "1,2", "-q"], capsys
-    )
-    _assert_one_line_error(status, err, "needs 5 gesture classes")
+    # Duplicate, unknown and missing classes are errors, not silently accepted.
+    for bad, match in [
+        ("1,2", "needs 5 gesture classes"),
+        ("1,1,1,1,1", "class 1 is given twice"),
+        ("1,2,3,4,9", "class 4 is not a class of the model"),
+    ]:
+        status, _, err = run([*base, "--commands", bad], capsys)
+        _assert_one_line_error(status, err, match)
+    status, _, err = run(base, capsys)  # 3 classes, 5 commands
+    _assert_one_line_error(status, err, "give a command file")
+
+
+def test_stream_publishes_commands_as_json_lines(model_b, tmp_path, capsys):
+    commands = tmp_path / "vocabulary.toml"
+    commands.write_text('[commands]\n1 = "stop"\n2 = "go"\n3 = "wave"\n')
+    base = ["stream", model_b, *HELD_OUT, "-q", "--commands"]
+    argv = [*base, commands, "--publish", "stdout", "--min-confidence", "0"]
+    status, out, err = run(argv, capsys)
+    assert status == 0, err
+    messages = [json.loads(line) for line in out.splitlines()]
+    assert messages, err
+    assert all(m["type"] == "command" for m in messages)
+    assert {m["command"] for m in messages} <= {"stop", "go", "wave"}
+    assert re.search(r"^\d+ events", err, re.M)  # the human lines went to stderr
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"commands": {"7": "stop"}}))
+    status, _, err = run([*base, bad], capsys)
+    _assert_one_line_error(status, err, "class 7 is not a class of the model")
+    status, _, err = run([*base, commands, "--publish", "udp://nowhere"], capsys)
+    _assert_one_line_error(status, err, "expected udp://HOST:PORT")
 
 
 def _event_lines(out):
