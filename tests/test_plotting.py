@@ -94,9 +94,11 @@ def test_gesture_timeline_bars_follow_the_labels():
 def _legend(ax):
     """``{label: facecolour}`` of the legend's patches, in legend order."""
     leg = ax.get_legend()
+    # legend_handles from matplotlib 3.7 on; legendHandles before (the floor, 3.6)
+    handles = getattr(leg, "legend_handles", None) or leg.legendHandles
     return {
         t.get_text(): to_rgb(h.get_facecolor())
-        for t, h in zip(leg.get_texts(), leg.legend_handles)
+        for t, h in zip(leg.get_texts(), handles)
         if hasattr(h, "get_facecolor")
     }
 
