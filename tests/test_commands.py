@@ -10,15 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.pipeline import Pipeline
+from _stand_ins import make_cheap_pipeline
 
-from skgesture import (
-    ActivitySegmenter,
-    DynamicPoseWindow,
-    MultiScaleClassifier,
-    PoseDescriptor,
-)
 from skgesture.datasets import load_precog
 from skgesture.streaming import (
     ActionMap,
@@ -343,46 +336,13 @@ def test_udp_publisher_over_a_real_socket():
 # -- a real stream ------------------------------------------------------------
 
 
-class ConstantProba(ClassifierMixin, BaseEstimator):
-    """Segmenter network stand-in: every frame has gesture probability ``p``."""
-
-    def __init__(self, p=0.9):
-        self.p = p
-
-    def fit(self, X, y):
-        self.classes_ = np.unique(y)
-        return self
-
-    def predict_proba(self, X):
-        return np.tile([1.0 - self.p, self.p], (len(X), 1))
-
-
-class CentroidProba(ClassifierMixin, BaseEstimator):
-    """Softmax of minus mean squared distances to class means (microseconds)."""
-
-    def fit(self, X, y):
-        self.classes_, inv = np.unique(y, return_inverse=True)
-        self.means_ = np.stack([X[inv == k].mean(0) for k in range(len(self.classes_))])
-        return self
-
-    def predict_proba(self, X):
-        d = -((np.asarray(X)[:, None, :] - self.means_[None]) ** 2).mean(-1)
-        e = np.exp(d - d.max(axis=1, keepdims=True))
-        return e / e.sum(axis=1, keepdims=True)
-
-
 def test_the_callback_receives_the_commands_of_a_stream():
     precog = load_precog()
     train = [i for i, g in enumerate(precog.groups) if g == 1]
     test = next(i for i, g in enumerate(precog.groups) if g == 8)
-    pipe = Pipeline([
-        ("descriptor", PoseDescriptor()),
-        ("segmenter", ActivitySegmenter(ConstantProba())),
-        ("windows", DynamicPoseWindow(steps=(4, 2))),
-        ("classifier", MultiScaleClassifier(
-            CentroidProba(), steps=(4, 2), threshold_short=0.2, threshold_long=0.2
-        )),
-    ]).fit([precog.X[i] for i in train], [precog.y[i] for i in train])  # fmt: skip
+    pipe = make_cheap_pipeline().fit(
+        [precog.X[i] for i in train], [precog.y[i] for i in train]
+    )
     names = list(precog.target_names)
     recognizer = StreamingRecognizer(pipe, target_names=names)
     cmap = CommandMap({name: f"do_{k}" for k, name in enumerate(names, 1)})

@@ -16,15 +16,8 @@ import warnings
 
 import numpy as np
 import pytest
-from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.pipeline import Pipeline
+from _stand_ins import make_cheap_pipeline
 
-from skgesture import (
-    ActivitySegmenter,
-    DynamicPoseWindow,
-    MultiScaleClassifier,
-    PoseDescriptor,
-)
 from skgesture.datasets import load_precog
 from skgesture.streaming import (
     LSLSource,
@@ -41,34 +34,6 @@ N_FRAMES = 400
 SOCKET_TIMEOUT = 5.0  # seconds; every socket and every stream ends by itself
 
 
-class ConstantProba(ClassifierMixin, BaseEstimator):
-    """Segmenter network stand-in: every frame has gesture probability ``p``."""
-
-    def __init__(self, p=0.9):
-        self.p = p
-
-    def fit(self, X, y):
-        self.classes_ = np.unique(y)
-        return self
-
-    def predict_proba(self, X):
-        return np.tile([1.0 - self.p, self.p], (len(X), 1))
-
-
-class CentroidProba(ClassifierMixin, BaseEstimator):
-    """Softmax of minus mean squared distances to class means (microseconds)."""
-
-    def fit(self, X, y):
-        self.classes_, inv = np.unique(y, return_inverse=True)
-        self.means_ = np.stack([X[inv == k].mean(0) for k in range(len(self.classes_))])
-        return self
-
-    def predict_proba(self, X):
-        d = -((np.asarray(X)[:, None, :] - self.means_[None]) ** 2).mean(-1)
-        e = np.exp(d - d.max(axis=1, keepdims=True))
-        return e / e.sum(axis=1, keepdims=True)
-
-
 @pytest.fixture(scope="module")
 def precog():
     return load_precog()
@@ -78,14 +43,7 @@ def precog():
 def pipe(precog):
     """Always-active segmenter and a numpy window classifier (fast)."""
     idx = [i for i, g in enumerate(precog.groups) if g == 1]
-    pipe = Pipeline([
-        ("descriptor", PoseDescriptor()),
-        ("segmenter", ActivitySegmenter(ConstantProba())),
-        ("windows", DynamicPoseWindow(steps=(4, 2))),
-        ("classifier", MultiScaleClassifier(
-            CentroidProba(), steps=(4, 2), threshold_short=0.2, threshold_long=0.2
-        )),
-    ])  # fmt: skip
+    pipe = make_cheap_pipeline()
     return pipe.fit([precog.X[i] for i in idx], [precog.y[i] for i in idx])
 
 

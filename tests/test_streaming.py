@@ -5,6 +5,7 @@ frames, streams starting mid-gesture, bounded memory, the protocol itself."""
 import numpy as np
 import pytest
 import torch
+from _stand_ins import ConstantProba, make_cheap_pipeline
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from sklearn.base import BaseEstimator, ClassifierMixin
@@ -14,8 +15,6 @@ from sklearn.pipeline import Pipeline
 
 from skgesture import (
     ActivitySegmenter,
-    DynamicPoseWindow,
-    MultiScaleClassifier,
     PoseDescriptor,
     TorchMLPClassifier,
     make_method_a,
@@ -43,34 +42,6 @@ def _tiny(pipe):
             hidden_layer_sizes=(32,), activations=("tanh",), max_epochs=30
         ),
     )
-
-
-class ConstantProba(ClassifierMixin, BaseEstimator):
-    """Segmenter network stand-in: every frame has gesture probability ``p``."""
-
-    def __init__(self, p=0.9):
-        self.p = p
-
-    def fit(self, X, y):
-        self.classes_ = np.unique(y)
-        return self
-
-    def predict_proba(self, X):
-        return np.tile([1.0 - self.p, self.p], (len(X), 1))
-
-
-class CentroidProba(ClassifierMixin, BaseEstimator):
-    """Softmax of minus mean squared distances to class means (microseconds)."""
-
-    def fit(self, X, y):
-        self.classes_, inv = np.unique(y, return_inverse=True)
-        self.means_ = np.stack([X[inv == k].mean(0) for k in range(len(self.classes_))])
-        return self
-
-    def predict_proba(self, X):
-        d = -((np.asarray(X)[:, None, :] - self.means_[None]) ** 2).mean(-1)
-        e = np.exp(d - d.max(axis=1, keepdims=True))
-        return e / e.sum(axis=1, keepdims=True)
 
 
 @pytest.fixture(scope="module")
@@ -109,14 +80,7 @@ def cheap_pipeline(precog):
     """Always-active segmenter and a numpy window classifier: fast, and every
     frame is inside a period, which stresses the period buffers."""
     X, y = _split(precog, (1,))
-    pipe = Pipeline([
-        ("descriptor", PoseDescriptor()),
-        ("segmenter", ActivitySegmenter(ConstantProba())),
-        ("windows", DynamicPoseWindow(steps=(4, 2))),
-        ("classifier", MultiScaleClassifier(
-            CentroidProba(), steps=(4, 2), threshold_short=0.2, threshold_long=0.2
-        )),
-    ])  # fmt: skip
+    pipe = make_cheap_pipeline()
     return pipe.fit(X, y)
 
 
