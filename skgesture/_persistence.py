@@ -3,8 +3,9 @@
 A model file is one zip archive with exactly three members:
 
 * ``manifest.json``: the format, the skgesture version that wrote it, the input
-  the model expects (frame shape, skeleton layout, descriptor joints), how to
-  rebuild each network, checksums of the other members, and user metadata;
+  the model expects (frame shape, skeleton layout, descriptor joints, frame
+  rate), how to rebuild each network, checksums of the other members, and user
+  metadata;
 * ``estimator.skops``: the estimator written by ``skops.io.dumps``, in which
   every skorch network is replaced by a placeholder and every class of the
   public API is named by its public name (``skgesture.PoseDescriptor``), so
@@ -410,6 +411,131 @@ def _rebuild_net(spec, tensors, index):
     return net
 
 
+def _deferrable(spec):
+    """The plain ``module__*`` parameters of a network whose prediction needs
+    no torch (a :class:`~skgesture.TorchMLPClassifier`'s MLP), else None."""
+    module = (spec.get("params") or {}).get("module")
+    path = module.get("__class__") if isinstance(module, dict) else None
+    if not isinstance(path, str) or not path.startswith("skgesture."):
+        return None
+    if path.rpartition(":")[2] != "MLPModule":
+        return None
+    params = {}
+    for name, value in spec["params"].items():
+        if name.startswith("module__"):
+            if not _is_plain(value):
+                return None
+            params[name] = _decode(value, {}, name)
+    return params
+
+
+def _is_plain(value):
+    """Whether a manifest value decodes without classes or tensors."""
+    if isinstance(value, list):
+        return all(_is_plain(v) for v in value)
+    if not isinstance(value, dict):
+        return True
+    if len(value) != 1:
+        return False
+    ((tag, inner),) = value.items()
+    if tag == "__tuple__":
+        return _is_plain(inner)
+    if tag == "__dict__" and isinstance(inner, dict):
+        return all(_is_plain(v) for v in inner.values())
+    return False
+
+
+def _built(net):
+    """A skorch net, built if it is a network of a model file not built yet."""
+    from skgesture._nn._deferred import DeferredNet
+
+    return net.materialize() if isinstance(net, DeferredNet) else net
+
+
+def _load_nets(path, specs, weights):
+    """``({index: net}, tensors)`` of a model file's networks and weights.
+
+    When every network is an MLP and no bare tensor is stored (Methods A and
+    B), the weights are read as numpy arrays and each network is a
+    :class:`~skgesture._nn._deferred.DeferredNet`, built with torch only if
+    something other than prediction asks for it: loading and predicting then
+    never import torch. Otherwise every network is rebuilt now.
+    """
+    deferred = [_deferrable(spec) for spec in specs]
+    arrays = None
+    if all(p is not None for p in deferred):
+        import safetensors.numpy
+
+        try:
+            arrays = safetensors.numpy.load(weights)
+        except Exception:  # e.g. a dtype numpy lacks: read it with torch below
+            arrays = None
+    if arrays is not None and all(k.startswith("net") for k in arrays):
+        from skgesture._nn._deferred import DeferredNet
+
+        nets = {}
+        for i, (spec, params) in enumerate(zip(specs, deferred)):
+            key = (spec.get("states") or {}).get("module_")
+            if not isinstance(key, str):
+                raise ModelFileError(f"{path}: network {i} has no module state")
+            own = {k: v for k, v in arrays.items() if k.startswith(f"net{i}.")}
+            module = {k[len(key) :]: v for k, v in own.items() if k.startswith(key)}
+            nets[i] = DeferredNet(
+                module, params, functools.partial(_rebuild_from_arrays, spec, own, i)
+            )
+        return nets, arrays
+    import safetensors.torch
+
+    try:
+        tensors = safetensors.torch.load(weights)
+    except Exception as exc:  # safetensors raises its own error types
+        raise ModelFileError(f"{path}: unreadable weights ({exc})") from None
+    return {i: _rebuild_net(spec, tensors, i) for i, spec in enumerate(specs)}, tensors
+
+
+def _rebuild_from_arrays(spec, arrays, index):
+    import torch
+
+    tensors = {k: torch.from_numpy(v.copy()) for k, v in arrays.items()}
+    return _rebuild_net(spec, tensors, index)
+
+
+def _skops_io():
+    """``skops.io``, imported without importing torch.
+
+    skops lists the scikit-learn types it trusts with
+    ``sklearn.utils.all_estimators``, whose walk over scikit-learn's packages
+    imports ``sklearn.externals.array_api_compat.torch`` (and its siblings for
+    other array libraries), hence torch: two seconds, for modules that hold
+    no estimator and that the walk then skips. They are refused while skops
+    is imported, and import as usual afterwards.
+    """
+    import sys
+
+    if "skops.io" not in sys.modules:
+        finder = _SkipArrayBackends()
+        sys.meta_path.insert(0, finder)
+        try:
+            import skops.io  # noqa: F401
+        finally:
+            sys.meta_path.remove(finder)
+    return sys.modules["skops.io"]
+
+
+class _SkipArrayBackends:
+    """An import hook refusing scikit-learn's vendored array-library adapters."""
+
+    PREFIX = "sklearn.externals.array_api_compat."
+    BACKENDS = {"torch", "cupy", "dask", "jax"}
+
+    def find_spec(self, name, path=None, target=None):
+        if name.startswith(self.PREFIX) and (
+            name[len(self.PREFIX) :].split(".")[0] in self.BACKENDS
+        ):
+            raise ImportError(f"{name} is not imported while skops is")
+        return None
+
+
 # -- walking an estimator --------------------------------------------------------
 
 # Objects whose attributes are not part of an estimator's state.
@@ -426,6 +552,8 @@ def _find_torch_objects(root):
     import torch
     from skorch import NeuralNet
 
+    from skgesture._nn._deferred import DeferredNet
+
     nets, tensors, seen = {}, {}, set()
     stack = [(root, "estimator")]
     while stack:
@@ -435,7 +563,7 @@ def _find_torch_objects(root):
         if id(obj) in seen:
             continue
         seen.add(id(obj))
-        if isinstance(obj, NeuralNet):
+        if isinstance(obj, (NeuralNet, DeferredNet)):
             nets.setdefault(id(obj), (obj, where))
         elif isinstance(obj, torch.Tensor):
             tensors.setdefault(id(obj), (obj, where))
@@ -453,10 +581,15 @@ def _find_torch_objects(root):
     return list(nets.values()), list(tensors.values())
 
 
-def _fill_slots(obj, nets, tensors, seen):
-    """Replace the placeholders under ``obj`` (in place); return ``obj``'s value."""
+def _fill_slots(obj, nets, tensors, seen, deferred_ok=False):
+    """Replace the placeholders under ``obj`` (in place); return ``obj``'s value.
+
+    A network stays deferred (:class:`~skgesture._nn._deferred.DeferredNet`)
+    only as the ``net_`` of a :class:`~skgesture.TorchMLPClassifier`, whose
+    prediction reads its arrays; anywhere else it is built.
+    """
     if isinstance(obj, _NetSlot):
-        return nets[obj.key]
+        return nets[obj.key] if deferred_ok else _built(nets[obj.key])
     if isinstance(obj, _TensorSlot):
         return tensors[obj.key]
     if obj is None or isinstance(obj, (str, bytes, int, float, np.ndarray, type)):
@@ -475,25 +608,30 @@ def _fill_slots(obj, nets, tensors, seen):
         for k, v in obj.items():
             obj[k] = _fill_slots(v, nets, tensors, seen)
     elif hasattr(obj, "__dict__") and not isinstance(obj, _OPAQUE):
+        from skgesture._nn._mlp import TorchMLPClassifier
+
+        mlp = isinstance(obj, TorchMLPClassifier)
         for k, v in list(vars(obj).items()):
-            new = _fill_slots(v, nets, tensors, seen)
+            new = _fill_slots(v, nets, tensors, seen, mlp and k == "net_")
             if new is not v:
                 vars(obj)[k] = new
     return obj
 
 
 def _input_layout(estimator):
-    """What the model takes: frame shape, skeleton layout and descriptor joints."""
+    """What the model takes: frame shape, layout, descriptor joints, frame rate."""
     from sklearn.pipeline import Pipeline
 
     first = estimator
     while isinstance(first, Pipeline) and first.steps:
         first = first.steps[0][1]
     shape = getattr(first, "frame_shape_in_", None)
+    fps = getattr(estimator, "fps_", None)  # a GesturePipeline's training rate
     info = {
         "frame_shape": None if shape is None else [int(s) for s in shape],
         "layout": None,
         "joints": None,
+        "fps": None if fps is None else float(fps),
     }
     from skgesture._descriptor._estimator import PoseDescriptor
     from skgesture._features import JointFeatures
@@ -623,7 +761,7 @@ def save_model(estimator, path, *, metadata=None, overwrite=False):
     nets, bare_tensors = _find_torch_objects(estimator)
     blobs, specs, memo = {}, [], {}
     for i, (net, where) in enumerate(nets):
-        specs.append(_net_spec(net, i, blobs, where))
+        specs.append(_net_spec(_built(net), i, blobs, where))
         memo[id(net)] = _NetSlot(i)
     for i, (tensor, _) in enumerate(bare_tensors):
         key = f"tensor{i}"
@@ -793,22 +931,39 @@ def _skgesture_classes():
     classes that are scikit-learn estimators) under their public names
     (``skgesture.PoseDescriptor``), the classes they hold that the table does
     not list (:data:`_SUPPORT_CLASSES`) under their public module, and the
-    placeholders of this module under their own path.
+    placeholders of this module under their own path (:func:`_stable_name`).
+    It imports every module of the table; reading a file needs only
+    :func:`_is_trusted_name`, which imports the modules the file names.
     """
+    import skgesture
+
+    candidates = [getattr(skgesture, name) for name in skgesture._LAZY]
+    candidates += [getattr(importlib.import_module(m), n) for m, n in _SUPPORT_CLASSES]
+    candidates += [_NetSlot, _TensorSlot]
+    names = {obj: _stable_name(obj) for obj in candidates if isinstance(obj, type)}
+    return {cls: name for cls, name in names.items() if name is not None}
+
+
+def _stable_name(cls):
+    """The name under which a model file of this version names ``cls``, or
+    None when ``cls`` is not a class of skgesture that a file may hold."""
     from sklearn.base import BaseEstimator
 
     import skgesture
 
-    classes = {}
-    for name in skgesture._LAZY:
-        obj = getattr(skgesture, name)
-        if isinstance(obj, type) and issubclass(obj, BaseEstimator):
-            classes[obj] = f"skgesture.{name}"
+    if cls in (_NetSlot, _TensorSlot):
+        return f"{cls.__module__}.{cls.__qualname__}"
     for module, name in _SUPPORT_CLASSES:
-        classes[getattr(importlib.import_module(module), name)] = f"{module}.{name}"
-    for cls in (_NetSlot, _TensorSlot):
-        classes[cls] = f"{cls.__module__}.{cls.__qualname__}"
-    return classes
+        if cls.__name__ == name and _resolve(f"{module}.{name}") is cls:
+            return f"{module}.{name}"
+    name = cls.__name__
+    if (
+        name in skgesture._LAZY
+        and getattr(skgesture, name) is cls
+        and issubclass(cls, BaseEstimator)
+    ):
+        return f"skgesture.{name}"
+    return None
 
 
 def _resolve(type_name):
@@ -820,31 +975,48 @@ def _resolve(type_name):
         return None
 
 
-@functools.cache
-def _trusted_type_names():
-    """Every type name under which ``load_model`` trusts a class of skgesture.
+def _names_of(cls, stable):
+    """Every name under which ``load_model`` trusts ``cls`` (stable name ``stable``).
 
-    For each class of :func:`_skgesture_classes`: its stable name (files of
-    this version), the module that defines it and the packages above that
-    module that export it (files written before public names were recorded;
-    0.1's ``skgesture._descriptor`` was a module), the module the API table
-    names for it, and its module paths of 0.1 (``skgesture._legacy.MOVED``).
-    A name is trusted only if it imports that very class, so nothing outside
-    the table is reachable through one.
+    Its stable name (files of this version), the module that defines it and
+    the packages above that module that export it (files written before public
+    names were recorded; 0.1's ``skgesture._descriptor`` was a module), the
+    module the API table names for it, and its module paths of 0.1
+    (``skgesture._legacy.MOVED``). A name is trusted only if it imports that
+    very class, so nothing outside the table is reachable through one.
     """
     import skgesture
 
+    name, module = cls.__name__, cls.__module__
+    parts = module.split(".")
+    candidates = {stable, f"{module}.{name}"}
+    candidates |= {".".join(parts[:i]) + f".{name}" for i in range(2, len(parts))}
+    if name in skgesture._LAZY:
+        candidates.add(f"{skgesture._LAZY[name]}.{name}")
+    candidates |= {f"{old}.{name}" for old in old_paths(cls)}
+    return {c for c in candidates if _resolve(c) is cls}
+
+
+@functools.cache
+def _trusted_type_names():
+    """Every type name under which ``load_model`` trusts a class of skgesture."""
     names = set()
     for cls, stable in _skgesture_classes().items():
-        name, module = cls.__name__, cls.__module__
-        parts = module.split(".")
-        candidates = {stable, f"{module}.{name}"}
-        candidates |= {".".join(parts[:i]) + f".{name}" for i in range(2, len(parts))}
-        if name in skgesture._LAZY:
-            candidates.add(f"{skgesture._LAZY[name]}.{name}")
-        candidates |= {f"{old}.{name}" for old in old_paths(cls)}
-        names |= {c for c in candidates if _resolve(c) is cls}
+        names |= _names_of(cls, stable)
     return frozenset(names)
+
+
+@functools.cache
+def _is_trusted_name(type_name):
+    """Whether ``type_name`` is one of :func:`_trusted_type_names`, importing
+    only the skgesture module that it names (not torch with the taggers)."""
+    if not type_name.startswith("skgesture."):
+        return False
+    cls = _resolve(type_name)
+    if not isinstance(cls, type):
+        return False
+    stable = _stable_name(cls)
+    return stable is not None and type_name in _names_of(cls, stable)
 
 
 def _renamed_modules():
@@ -939,7 +1111,7 @@ def model_info(path):
     ...                   metadata={"note": "unfitted"})
     >>> info = model_info(path)
     >>> info["estimator"], info["metadata"]
-    ('sklearn.pipeline:Pipeline', {'note': 'unfitted'})
+    ('skgesture:GesturePipeline', {'note': 'unfitted'})
     >>> folder.cleanup()
     """
     return _read_members(path)[1]
@@ -1022,9 +1194,7 @@ def load_model(path, *, trusted=None, layout=None, allow_version_mismatch=False)
     True
     >>> folder.cleanup()
     """
-    import safetensors.torch
-    import skops.io as sio
-
+    sio = _skops_io()
     path, manifest, data = _read_members(path)
     _check_version(path, manifest, allow_version_mismatch)
     _check_layout(path, manifest, layout)
@@ -1033,23 +1203,14 @@ def load_model(path, *, trusted=None, layout=None, allow_version_mismatch=False)
     except Exception as exc:  # a damaged skops archive or schema
         raise ModelFileError(f"{path}: unreadable estimator ({exc})") from None
     user_trusted = set(trusted or ())
-    refused = [
-        t for t in found if t not in user_trusted and t not in _trusted_type_names()
-    ]
+    refused = [t for t in found if t not in user_trusted and not _is_trusted_name(t)]
     if refused:
         raise UntrustedTypesError(
             f"{path} holds types that are not trusted: {', '.join(refused)}. If "
             f"you trust the file's origin, pass trusted=[...] naming them",
             refused,
         )
-    try:
-        tensors = safetensors.torch.load(data[WEIGHTS])
-    except Exception as exc:  # safetensors raises its own error types
-        raise ModelFileError(f"{path}: unreadable weights ({exc})") from None
-    nets = {
-        i: _rebuild_net(spec, tensors, i)
-        for i, spec in enumerate(manifest.get("nets") or [])
-    }
+    nets, tensors = _load_nets(path, manifest.get("nets") or [], data[WEIGHTS])
     try:
         estimator = sio.loads(data[ESTIMATOR], trusted=found)
     except Exception as exc:  # skops raises many types on a damaged schema

@@ -147,6 +147,15 @@ def test_the_fixtures_are_complete_and_from_0_1(stored):
     assert not (Path(skgesture.__file__).parent / "_tagger.py").exists()
 
 
+# Models whose networks are TorchMLPClassifiers: since 0.2 their forward pass
+# runs in numpy (skgesture._nn._fast.MLPProba), equal to 0.1's torch pass to
+# float32 rounding; everything decided from it (labels, segments) is identical.
+FLOAT32_ROUNDING = {"method_b"}
+# the columns of those outputs that are probabilities (segments and events:
+# class, start, end, confidence[, emitted_at]; the segmenter's decision: all)
+ROUNDED_COLUMNS = {"predict_segments": [3], "stream": [3], "segmenter_decision": [0]}
+
+
 @needs_fixture_libraries
 @pytest.mark.parametrize("kind", ["skg", "joblib"])
 @pytest.mark.parametrize("name", NAMES)
@@ -159,9 +168,19 @@ def test_legacy_model_gives_identical_outputs(name, kind, stored):
     for quantity, want in expected[name].items():
         assert len(got[quantity]) == len(want)
         for i, (a, b) in enumerate(zip(got[quantity], want)):
-            assert a.shape == b.shape and np.array_equal(a, b), (
-                f"{name}.{kind}: {quantity} of sequence {i} differs from 0.1's"
-            )
+            where = f"{name}.{kind}: {quantity} of sequence {i} differs from 0.1's"
+            assert a.shape == b.shape, where
+            if name in FLOAT32_ROUNDING and quantity in ROUNDED_COLUMNS:
+                # labels and frames exactly; probabilities and confidences to
+                # float32 rounding
+                rounded = ROUNDED_COLUMNS[quantity]
+                exact = np.ones(a.shape[-1:] if a.ndim > 1 else (1,), bool)
+                exact[rounded] = False
+                if a.ndim > 1:
+                    assert np.array_equal(a[:, exact], b[:, exact]), where
+                np.testing.assert_allclose(a, b, rtol=0, atol=1e-6, err_msg=where)
+            else:
+                assert np.array_equal(a, b), where
 
 
 def _schema(path):
@@ -231,7 +250,7 @@ def test_new_files_record_public_names(fitted, tmp_path):
         }
     assert expected <= seen
     # the manifest names the estimator's class the same way
-    assert model_info(path)["estimator"] == "sklearn.pipeline:Pipeline"
+    assert model_info(path)["estimator"] == "skgesture:GesturePipeline"
     path = save_model(TorchMLPClassifier(), tmp_path / "mlp.skg")
     assert model_info(path)["estimator"] == "skgesture:TorchMLPClassifier"
     assert set(_class_nodes(_schema(path))) >= {("skgesture", "TorchMLPClassifier")}

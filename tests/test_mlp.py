@@ -10,7 +10,7 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 
 from skgesture import TorchMLPClassifier
-from skgesture._nn._training import seed_from
+from skgesture.utils._fitting import seed_from
 
 SOLVERS = ("scg", "adam", "lbfgs")
 FAST = {"hidden_layer_sizes": (8,), "activations": ("tanh",), "max_epochs": 30}

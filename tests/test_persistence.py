@@ -336,6 +336,7 @@ def test_model_info_records_version_layout_and_metadata(fitted, tmp_path):
         "frame_shape": [20, 3],
         "layout": "kinect_v1",
         "joints": "paper11",
+        "fps": 30.0,  # GesturePipeline's default training rate
     }
     assert info["classes"] == [1, 2, 3]
     assert info["metadata"] == {"target_names": ["a", "b", "c"]}

@@ -7,7 +7,7 @@ from numbers import Integral
 
 import numpy as np
 
-from skgesture._nn._fast import fast_proba
+from skgesture._nn._mlp import fast_proba
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamSegment
 from skgesture._windows import (
     DynamicPoses,

@@ -2,29 +2,21 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import functools
 from numbers import Integral, Real
 
 import numpy as np
-import torch
 from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from skgesture._nn._modules import _ACTIVATIONS
-from skgesture._nn._training import (
-    SCG_MAX_FAIL,
-    TEST_FRACTION,
-    TORCH_RNG_LOCK,
-    VALIDATION_FRACTION,
-    build_net,
-    predict_module,
-    seed_from,
-    torch_threads,
-)
+from skgesture._nn._defaults import SCG_MAX_FAIL, TEST_FRACTION, VALIDATION_FRACTION
+from skgesture._nn._fast import ACTIVATIONS, MLPProba
+from skgesture.utils._fitting import seed_from
 from skgesture.utils._validation import SequenceOf
 
-__all__ = ["TorchMLPClassifier"]
+__all__ = ["TorchMLPClassifier", "fast_proba"]
 
 
 class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
@@ -62,10 +54,11 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
     device : str, default="cpu"
         Torch device, passed to skorch.
     n_threads : int or None, default=1
-        Torch intra-op CPU threads while fitting and predicting (the previous
-        setting is restored afterwards); ``None`` keeps torch's setting. One
-        thread is fastest for the paper's small networks and never
-        oversubscribes a busy machine or parallel jobs (docs/design.md §6).
+        CPU threads while fitting (torch's intra-op threads) and predicting
+        (the BLAS threads of numpy); the previous setting is restored
+        afterwards, and ``None`` keeps it. One thread is fastest for the
+        paper's small networks and never oversubscribes a busy machine or
+        parallel jobs (docs/design.md §6).
     random_state : int, RandomState instance or None, default=None
         Seeds the initialisation, the data division and the shuffling.
     verbose : int, default=0
@@ -102,8 +95,8 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         "hidden_layer_sizes": [SequenceOf.ints(1, allow_empty=True)],
         "activations": [
             SequenceOf(
-                lambda a: isinstance(a, str) and a in _ACTIVATIONS,
-                f"a tuple of names among {sorted(_ACTIVATIONS)}",
+                lambda a: isinstance(a, str) and a in ACTIVATIONS,
+                f"a tuple of names among {sorted(ACTIVATIONS)}",
                 allow_empty=True,
             )
         ],
@@ -167,6 +160,10 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         self : TorchMLPClassifier
             The fitted classifier.
         """
+        import torch
+
+        from skgesture._nn._training import TORCH_RNG_LOCK, build_net, torch_threads
+
         X, y = validate_data(self, X, y, dtype=np.float32)
         check_classification_targets(y)
         if len(self.activations) != len(self.hidden_layer_sizes):
@@ -237,15 +234,22 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         -------
         ndarray of shape (n_samples, n_classes)
             Probabilities, rows sum to 1, columns in ``classes_`` order.
+
+        Notes
+        -----
+        The forward pass runs in numpy (float32, the module's weights; equal
+        to torch's to float32 rounding), so that a model file loaded for
+        prediction never imports torch, and the live step computes exactly
+        what this method does.
         """
         check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float32, reset=False)
-        # getattr: a model pickled before n_threads existed keeps torch's setting.
-        with torch_threads(getattr(self, "n_threads", None)):
-            if len(self.classes_) == 2:
-                p = predict_module(self.net_.module_, X, "sigmoid")
-                return np.column_stack([1.0 - p, p])
-            return predict_module(self.net_.module_, X, "softmax")
+        # getattr: a model pickled before n_threads existed keeps the BLAS setting.
+        n_threads = getattr(self, "n_threads", None)
+        if n_threads is None:
+            return MLPProba(self)(X)
+        with _blas_controller().limit(limits=n_threads, user_api="blas"):
+            return MLPProba(self)(X)
 
     def predict(self, X):
         """Most probable class.
@@ -267,3 +271,25 @@ class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
         tags = super().__sklearn_tags__()
         tags.non_deterministic = False
         return tags
+
+
+def fast_proba(estimator):
+    """``predict_proba`` of a fitted 2-D classifier, as a fast callable.
+
+    For a :class:`TorchMLPClassifier` its one inference path
+    (:class:`~skgesture._nn._fast.MLPProba`) without the per-call input
+    validation of ``predict_proba``, which costs more than the forward pass of
+    one row: the same numbers. Any other classifier's own ``predict_proba``
+    is returned.
+    """
+    if not isinstance(estimator, TorchMLPClassifier):
+        return estimator.predict_proba
+    return MLPProba(estimator)
+
+
+@functools.cache
+def _blas_controller():
+    """One scan of the loaded BLAS libraries, reused by every prediction."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()

@@ -19,8 +19,8 @@ from skgesture._nn._training import (
     IGNORE_INDEX,
     FramewiseNetwork,
     SequenceSplit,
-    seed_from,
 )
+from skgesture.utils._fitting import seed_from
 
 MIN_SCALE = 1e-6  # a feature with a smaller training std keeps scale 1
 
@@ -164,15 +164,20 @@ class WarmupCosine:
         )
 
 
-def _module_spec(architecture, hidden_sizes, dropout, tcn_layers, tcn_stages):
+def _module_spec(
+    architecture, hidden_sizes, dropout, tcn_layers, tcn_stages, lookahead=None
+):
     """Module class and keyword arguments of an ``architecture``."""
     if architecture == "tcn":
-        return TemporalConvModule, {
+        kwargs = {
             "channels": int(hidden_sizes[0]),
             "n_layers": int(tcn_layers),
             "n_stages": int(tcn_stages),
             "dropout": float(dropout),
         }
+        if lookahead is not None:  # (absent: the files of whole-sequence TCNs)
+            kwargs["lookahead"] = int(lookahead)
+        return TemporalConvModule, kwargs
     return RecurrentTaggerModule, {
         "hidden_sizes": tuple(int(h) for h in hidden_sizes),
         "cell": architecture,
@@ -201,6 +206,7 @@ class _CropNet(FramewiseNetwork):
         dropout=0.0,
         tcn_layers=8,
         tcn_stages=2,
+        lookahead=None,
         smoothing_weight=0.0,
         crop_length=128,
         batch_size=32,
@@ -225,6 +231,7 @@ class _CropNet(FramewiseNetwork):
         self.dropout = dropout
         self.tcn_layers = tcn_layers
         self.tcn_stages = tcn_stages
+        self.lookahead = lookahead
         self.smoothing_weight = smoothing_weight
         self.crop_length = crop_length
         self.batch_size = batch_size
@@ -268,6 +275,7 @@ class _CropNet(FramewiseNetwork):
             self.dropout,
             self.tcn_layers,
             self.tcn_stages,
+            self.lookahead,
         )
         schedule = [
             (

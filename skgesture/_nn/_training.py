@@ -3,12 +3,10 @@
 :func:`build_net` makes the skorch net of any of the paper's MLPs;
 :class:`FramewiseNetwork` holds the one training loop of every framewise tagger
 network (Method C's BiLSTM and the recommended taggers). Estimators that
-own networks fit them through :func:`fit_cached`, which caches the fitted network
-with ``joblib.Memory`` keyed on the training data and the network's own
-parameters only, so decision parameters (thresholds, weights, smoothing,
-minimum lengths) can be searched by ``GridSearchCV`` without retraining
-(docs/design.md §3). Every network is a :class:`LeanNet`, which leaves its
-training-only state out of pickles.
+own networks fit them through :func:`~skgesture.utils._fitting.fit_cached`,
+which caches the fitted network keyed on the training data and the network's
+own parameters only (docs/design.md §3). Every network is a :class:`LeanNet`,
+which leaves its training-only state out of pickles.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -20,15 +18,19 @@ from contextlib import contextmanager
 
 import numpy as np
 import torch
-from sklearn.base import BaseEstimator, clone
-from sklearn.utils import check_random_state
-from sklearn.utils.validation import check_memory
+from sklearn.base import BaseEstimator
 from skorch import NeuralNet
 from skorch.callbacks import Callback, EarlyStopping
 from skorch.dataset import Dataset
 from torch import nn
 from torch.nn import functional as F
 
+from skgesture._nn._defaults import (
+    SCG_MAX_FAIL,
+    SCG_MIN_GRAD,
+    TEST_FRACTION,
+    VALIDATION_FRACTION,
+)
 from skgesture._nn._modules import MLPModule
 
 __all__ = [
@@ -38,20 +40,10 @@ __all__ = [
     "SequenceSplit",
     "MLPModule",
     "build_net",
-    "fit_cached",
     "held_out_sequences",
-    "predict_module",
-    "seed_from",
     "torch_threads",
 ]
 
-# MATLAB trainscg defaults, docs/method.md §8.6.1
-SCG_MAX_FAIL = 6
-SCG_MIN_GRAD = 1e-6
-# MATLAB dividerand defaults, docs/method.md §8.6.4
-VALIDATION_FRACTION = 0.15
-TEST_FRACTION = 0.15
-PREDICT_BATCH = 65536
 IGNORE_INDEX = -100  # target of frames a framewise loss leaves out (padding, untracked)
 SMOOTHING_CLAMP = 16.0  # MS-TCN's truncation of the squared log-prob change
 
@@ -448,15 +440,16 @@ def _silent(*args, **kwargs):
 class FramewiseNetwork(BaseEstimator):
     """The trainable part of a tagger, with the training loop every tagger shares.
 
-    A subclass is fitted through :func:`fit_cached` (its parameters are the
-    network and training parameters only, so a tagger's decoding parameters
-    never change the cache key). Its ``fit`` prepares what differs between
-    taggers: the sampler of the training data (a dataset, its iterators and a
-    ``train_split`` holding out whole sequences), the module, the optimiser
-    and the schedule; :meth:`_train` does the rest, the same way for every
-    tagger: the loss (:class:`FramewiseLoss`), early stopping on the held-out
-    sequences (best epoch restored), progress (``verbose``), the device, and
-    seeding under ``TORCH_RNG_LOCK``.
+    A subclass is fitted through :func:`~skgesture.utils._fitting.fit_cached`
+    (its parameters are the network and training parameters only, so a
+    tagger's decoding parameters never change the cache key). Its ``fit``
+    prepares what differs between taggers: the sampler of the training data
+    (a dataset, its iterators and a ``train_split`` holding out whole
+    sequences), the module, the optimiser and the schedule; :meth:`_train`
+    does the rest, the same way for every tagger: the loss
+    (:class:`FramewiseLoss`), early stopping on the held-out sequences (best
+    epoch restored), progress (``verbose``), the device, and seeding under
+    ``TORCH_RNG_LOCK``.
 
     A subclass has the parameters ``max_epochs``, ``batch_size``,
     ``learning_rate``, ``early_stopping``, ``n_iter_no_change``, ``device``
@@ -545,10 +538,6 @@ def _solver_settings(solver, learning_rate, batch_size, n_samples):
     raise ValueError(f"solver must be 'scg', 'adam' or 'lbfgs', got {solver!r}")
 
 
-def _to_float32(X):
-    return np.ascontiguousarray(X, dtype=np.float32)
-
-
 def build_net(
     module_params,
     *,
@@ -629,104 +618,3 @@ def torch_threads(n_threads):
         yield
     finally:
         torch.set_num_threads(before)
-
-
-def _fit_clone(estimator, X, y, verbose=None):
-    est = clone(estimator)
-    if verbose is not None:
-        est.set_params(verbose=verbose)
-    return est.fit(X, y)
-
-
-def fit_cached(memory, estimator, X, y):
-    """Fit a clone of ``estimator`` on ``(X, y)``, cached by ``memory``.
-
-    The cache key is the estimator's parameters and the data, nothing else: an
-    estimator holding this network sees the same cached network whatever its own
-    decision parameters are (docs/design.md §3). Its ``verbose`` is left out of the
-    key too: showing progress never retrains a cached network.
-
-    Parameters
-    ----------
-    memory : None, str or joblib.Memory
-        Where to cache; ``None`` disables caching.
-    estimator : estimator
-        The unfitted estimator (its ``random_state`` must be an int or None to
-        give a stable key).
-    X, y : array-like
-        Training data.
-
-    Returns
-    -------
-    estimator
-        The fitted clone.
-    """
-    memory = check_memory(memory)
-    verbose = None
-    if "verbose" in estimator.get_params(deep=False):
-        verbose = estimator.get_params(deep=False)["verbose"]
-        estimator = clone(estimator).set_params(verbose=0)
-    fitted = memory.cache(_fit_clone, ignore=["verbose"])(estimator, X, y, verbose)
-    if verbose is not None:
-        fitted.set_params(verbose=verbose)  # as asked, even from the cache
-    return fitted
-
-
-def predict_module(module, X, output):
-    """Probabilities of a torch module on ``X``, in batches, as float64.
-
-    Parameters
-    ----------
-    module : torch.nn.Module
-        Trained module returning logits.
-    X : ndarray of shape (n_samples, n_inputs)
-        Inputs.
-    output : {"sigmoid", "softmax"}
-        Output map applied to the logits.
-
-    Returns
-    -------
-    ndarray of shape (n_samples,) or (n_samples, n_classes)
-        Probabilities.
-    """
-    module.eval()
-    device = next(module.parameters()).device
-    outs = []
-    with torch.inference_mode():
-        for start in range(0, len(X), PREDICT_BATCH):
-            xb = torch.as_tensor(
-                _to_float32(X[start : start + PREDICT_BATCH]), device=device
-            )
-            logits = module(xb)
-            if output == "sigmoid":
-                prob = torch.sigmoid(logits)[:, 0]
-            else:
-                prob = torch.softmax(logits, dim=1)
-            outs.append(prob.cpu().numpy().astype(np.float64))
-    if not outs:
-        width = module.net[-1].out_features
-        return np.zeros((0,) if output == "sigmoid" else (0, width))
-    return np.concatenate(outs)
-
-
-def seed_from(random_state):
-    """An int seed for torch drawn from a numpy ``random_state`` (docs/design.md §9)."""
-    return int(check_random_state(random_state).randint(np.iinfo(np.int32).max))
-
-
-def fit_inner_estimator(estimator, default, X, y, *, rng, memory, verbose=0):
-    """Fit a clone of ``estimator`` (or of ``default``) for a sequence estimator.
-
-    When ``rng`` is given, an int seed drawn from it replaces the clone's
-    ``random_state`` (if it has one), so one ``random_state`` on the outer
-    estimator controls every network it trains. A ``verbose`` above 0 is handed
-    on to the clone (if it has that parameter), so the outer estimator's
-    verbosity shows the network's progress: a bar at 1, one line per epoch at 2.
-    """
-    est = clone(default if estimator is None else estimator)
-    params = est.get_params()
-    if rng is not None and "random_state" in params:
-        est.set_params(random_state=seed_from(rng))
-    if verbose and "verbose" in params:
-        est.set_params(verbose=verbose)
-    return fit_cached(memory, est, X, y)

@@ -31,12 +31,12 @@ from skgesture._nn._training import (
     FramewiseLoss,
     FramewiseNetwork,
     SequenceSplit,
-    seed_from,
 )
 from skgesture._stream import DEFAULT_MAX_PERIOD
 from skgesture._taggers._base import _BaseTagger, _rest_where
 from skgesture._taggers._decoding import smooth_proba
 from skgesture._taggers._stream import TaggerStream
+from skgesture.utils._fitting import seed_from
 from skgesture.utils._segments import _chunks
 from skgesture.utils._validation import SequenceOf
 
@@ -552,7 +552,9 @@ class BiLSTMTagger(_BaseTagger):
             Per-frame features (e.g. from :class:`PoseDescriptor`).
         y : list of ndarray of shape (n_frames_i,)
             Per-frame labels, 0 = rest, 1..K gesture classes; both rest and
-            gesture frames must occur.
+            gesture frames must occur. A sequence whose labels are all 0 is a
+            background recording (ordinary motion, no command in it): its
+            windows are rest windows like any other.
 
         Returns
         -------

@@ -9,12 +9,12 @@ from sklearn.base import _fit_context, clone
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 
-from skgesture._nn._training import seed_from
 from skgesture._taggers._base import (
     _DECODING_CONSTRAINTS,
     _STREAM_CONSTRAINTS,
     _BaseTagger,
 )
+from skgesture.utils._fitting import seed_from
 
 __all__ = ["VotingTagger"]
 
@@ -130,7 +130,8 @@ class VotingTagger(_BaseTagger):
         X : list of ndarray of shape (n_frames_i, n_features)
             Per-frame features.
         y : list of ndarray of shape (n_frames_i,)
-            Per-frame labels.
+            Per-frame labels, 0 = rest; a sequence whose labels are all 0 is
+            a background recording, which every tagger learns as rest.
 
         Returns
         -------
