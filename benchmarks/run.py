@@ -24,6 +24,9 @@ SECTIONS = {
     "streaming": ("bench_streaming", "Streaming recognition: latency and delay"),
     "predict": ("bench_predict", "Prediction cost per frame, Methods A and B"),
     "scale": ("bench_scale", "Scale"),
+    "rate": ("bench_rate", "Frame rates: trained at 30 fps, tested at 15, 10, 20, 60"),
+    "startup": ("bench_startup", "Command-line start-up: cold process vs its work"),
+    "oov": ("bench_oov", "Out-of-vocabulary rejection: false events/min vs recall"),
     "compare": (
         "bench_compare",
         "skgesture beside the peers (seed means; cached in bench_results/compare)",

@@ -39,7 +39,7 @@ if "--fast" in sys.argv[1:]:
             hidden_layer_sizes=(64,), activations=("tanh",), max_epochs=100
         ),
     )
-model.fit([data.X[i] for i in train], [data.y[i] for i in train])
+model.fit([data.X[i] for i in train], [data.y[i] for i in train], fps=data.fps)
 
 # %%
 X_te = [data.X[i] for i in test]

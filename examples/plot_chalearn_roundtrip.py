@@ -45,7 +45,9 @@ model = make_method_a(random_state=0).set_params(
     classifier__estimator=TorchMLPClassifier(hidden_layer_sizes=(64,), **small),
 )
 model.fit(
-    [x for x, t in zip(data.X, train) if t], [y for y, t in zip(data.y, train) if t]
+    [x for x, t in zip(data.X, train) if t],
+    [y for y, t in zip(data.y, train) if t],
+    fps=data.fps,  # the model records the rate it was trained at
 )
 X_test = [x for x, t in zip(data.X, test) if t]
 y_test = [y for y, t in zip(data.y, test) if t]

@@ -281,7 +281,7 @@ def main():
     t0 = time.perf_counter()
     data, y5, train, test = make_data(args.fast, args.seed)
     pipe = make_model(args.method, args.fast, args.seed)
-    pipe.fit([data.X[i] for i in train], [y5[i] for i in train])
+    pipe.fit([data.X[i] for i in train], [y5[i] for i in train], fps=data.fps)
     label = {"C": "Method C (the paper's robot model)", "B": "Method B"}.get(
         args.method, "the recommended model"
     )

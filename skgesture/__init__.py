@@ -28,6 +28,7 @@ _LAZY = {
     "SkeletonAugmenter": "skgesture._augment",
     "SequenceTagger": "skgesture._taggers._sequence",
     "VotingTagger": "skgesture._taggers._voting",
+    "GesturePipeline": "skgesture._gesture_pipeline",
     "make_recommended": "skgesture._pipelines",
     "make_method_a": "skgesture._pipelines",
     "make_method_b": "skgesture._pipelines",

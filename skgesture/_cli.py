@@ -57,6 +57,10 @@ FPS_HELP = (
     "frame rate of the data (default: what the data say; your own recordings: "
     "the model's, else 30)"
 )
+FPS_RATE_HELP = (
+    "frame rate of the data (default: what the data say; your own recordings: "
+    "the model's); the model resamples data at another rate to its own"
+)
 DEFAULT_MAX_TIMELINES = 12  # sequences drawn by `plot timeline`
 
 
@@ -332,6 +336,16 @@ def build_parser():
     _add_fps(p, FPS_HELP + " (written to the model file)")
     _add_method(p)
     p.add_argument(
+        "--background",
+        action="append",
+        metavar="DIR",
+        help="recordings of ordinary work with no command in them (a folder of "
+        "your own recordings, read like DATA; labels are not needed), learnt "
+        "as rest so that everyday motion fires no gesture; 'synthetic' makes "
+        "background sequences from the training recordings "
+        "(skgesture.datasets.make_background). May be given more than once",
+    )
+    p.add_argument(
         "-o", "--output", default="model.skg", help="model file (default model.skg)"
     )
     p.add_argument("--overwrite", action="store_true", help="replace the model file")
@@ -343,6 +357,7 @@ def build_parser():
     )
     _add_data(p, with_model=True)
     _add_model_loading(p)
+    _add_fps(p, FPS_RATE_HELP)
     p.add_argument("--json", action="store_true", help="print the scores as JSON")
     _add_common(p)
     p.set_defaults(func=cmd_evaluate)
@@ -352,6 +367,7 @@ def build_parser():
     )
     _add_data(p, with_model=True)
     _add_model_loading(p)
+    _add_fps(p, FPS_RATE_HELP)
     p.add_argument("-o", "--output", required=True, help="output folder")
     p.add_argument(
         "--predict-format",

@@ -10,6 +10,7 @@ them and ``main`` are in :mod:`skgesture._cli`.
 import contextlib
 import functools
 import json
+import math
 import signal
 import sys
 import time
@@ -24,22 +25,27 @@ from skgesture._cli_support import (
     _class_name,
     _frame_rate,
     _info,
+    _input_rates,
     _joints,
     _live_bars,
     _load_data,
     _load_model,
     _loader_verbose,
     _make_model,
+    _model_fps,
     _model_target_names,
     _n_frames,
     _parse_subjects,
     _predict,
     _print_scores,
     _progress,
+    _rate_options,
     _scores,
     _select_subjects,
     _subset,
     _target_names,
+    _training_rate,
+    _warn_unknown_rate,
 )
 
 __all__ = [
@@ -70,13 +76,24 @@ def cmd_train(args):
     verbose = 0 if args.quiet else 1
     joints = _joints(args, data)
     pipe = _make_model(args, verbose, joints)
+    fps = _training_rate(args, data, kind)
+    _warn_unknown_rate(args, data, kind, fps, "the rate the model is trained at")
+    X_bg = _background(args, data)
     _info(
         args,
         f"training method {args.method} (joints {joints}) on {name}: "
-        f"{len(data.X)} sequences, {_n_frames(data):,} frames",
+        f"{len(data.X)} sequences, {_n_frames(data):,} frames at {fps:g} fps"
+        + (
+            f", and {len(X_bg)} background sequences "
+            f"({sum(len(x) for x in X_bg):,} frames)"
+            if X_bg
+            else ""
+        ),
     )
     start = time.perf_counter()
-    pipe.fit(data.X, data.y)
+    X = list(data.X) + X_bg
+    y = list(data.y) + [np.zeros(len(x), dtype=int) for x in X_bg]
+    pipe.fit(X, y, fps=fps)
     seconds = time.perf_counter() - start
     metadata = {
         "method": args.method,
@@ -86,6 +103,8 @@ def cmd_train(args):
         "subjects": args.subjects,
         "n_sequences": len(data.X),
         "n_frames": _n_frames(data),
+        "background": args.background,
+        "n_background_frames": int(sum(len(x) for x in X_bg)),
         "target_names": _target_names(data),
         "fps": _frame_rate(args, data, kind),
         "seed": args.seed,
@@ -96,11 +115,36 @@ def cmd_train(args):
     return 0
 
 
+def _background(args, data):
+    """The ``--background`` sequences: skeletons, all rest (labels ignored)."""
+    from skgesture import datasets
+
+    out = []
+    for spec in args.background or ():
+        if spec == "synthetic":
+            made = datasets.make_background(data.X, data.y, random_state=args.seed)
+            out += list(made.X)
+            continue
+        path = Path(spec).expanduser()
+        if not path.exists():
+            raise UsageError(f"--background {spec}: no such file or folder")
+        fps = {"fps": args.fps} if args.fps else {}
+        bg = datasets.load_recordings(
+            path, layout=args.layout, labels=False, verbose=_loader_verbose(args), **fps
+        )
+        if not len(bg.X):
+            raise UsageError(f"--background {spec}: no recording found")
+        out += list(bg.X)
+    return out
+
+
 def cmd_evaluate(args):
     data, kind, name = _load_data(args, need_labels=True)
     model, info = _load_model(args, data)
     names = _target_names(data, info)
-    y_pred = _predict(args, model, data.X, data.get("sample_ids"))
+    _warn_unknown_rate(args, data, kind, _model_fps(model, info))
+    rates = _input_rates(args, data, kind)
+    y_pred = _predict(args, model, data.X, data.get("sample_ids"), rates, info)
     scores = _scores(data, kind, y_pred, names)
     meta = info.get("metadata") or {}
     if args.json:
@@ -183,7 +227,9 @@ def cmd_predict(args):
     if existing and not args.overwrite:
         more = f" (and {len(existing) - 1} more)" if len(existing) > 1 else ""
         raise UsageError(f"{existing[0]} exists{more}; pass --overwrite to replace")
-    y_pred = _predict(args, model, data.X, data.get("sample_ids"))
+    _warn_unknown_rate(args, data, kind, _model_fps(model, info))
+    rates = _input_rates(args, data, kind)
+    y_pred = _predict(args, model, data.X, data.get("sample_ids"), rates, info)
     out.mkdir(parents=True, exist_ok=True)
     if fmt == "chalearn":
         from skgesture.datasets import write_chalearn_predictions
@@ -280,7 +326,8 @@ def cmd_plot(args):
         else:
             n = len(data.X) if kind == "confusion" else args.max_sequences
             X, y = data.X[:n], data.y[:n]
-            y_pred = _predict(args, model, X)
+            rates = _input_rates(args, data, data_kind)
+            y_pred = _predict(args, model, X, rates=rates and rates[:n], info=info)
             if kind == "confusion":
                 ax = plotting.plot_confusion_matrix(
                     y,
@@ -394,6 +441,7 @@ def _delay_bound(recognizer, fps):
     short = getattr(last, "short_length", None)
     if short is None or recognizer.early_decision:
         return bound, text
+    short = math.ceil(int(short) * recognizer.ratio)  # in input frames
     wait = int(recognizer.lookahead) + int(short) - 1
     if wait <= bound:
         return bound, text
@@ -596,7 +644,7 @@ def cmd_stream(args):
 
         # the sources' frames: Kinect v1, whatever the sender's layout
         model, info = _load_model(args, frame_shape=(KINECT_V1.n_joints, N_COORDS))
-        fps = args.fps or (info.get("metadata") or {}).get("fps") or 30.0
+        fps = args.fps or _model_fps(model, info) or 30.0
         names = _target_names(None, info)
     else:
         data, data_kind, name = _load_data(args, need_labels=False)
@@ -605,15 +653,24 @@ def cmd_stream(args):
         stream = np.asarray(data.X[i])
         fps = _frame_rate(args, data, data_kind, info, i) or 30.0
         names = _target_names(data, info)
-    recognizer = StreamingRecognizer(model, target_names=names)
-    commander, robot = _commander(args, recognizer, names, fps)
+        _warn_unknown_rate(args, _subset(data, [i]), data_kind, _model_fps(model, info))
     source = bar = None
+    if spec is not None:
+        source, where = _open_source(args, spec, fps)
+        fps = source.fps  # an LSL stream's nominal rate
+    try:
+        # the frames' rate, where the model knows its own (it resamples)
+        rate = (_rate_options(model, [fps], info) or [{}])[0]
+        recognizer = StreamingRecognizer(model, target_names=names, **rate)
+        commander, robot = _commander(args, recognizer, names, fps)
+    except BaseException:
+        if source is not None:
+            source.close()
+        raise
     # With --publish stdout, stdout carries only the commands' JSON lines.
     human = sys.stderr if "stdout" in (args.publish or ()) else sys.stdout
     write = functools.partial(print, file=human)
     if spec is not None:
-        source, where = _open_source(args, spec, fps)
-        fps = source.fps
         frames = source
         write = functools.partial(print, file=human, flush=True)  # a pipe sees each
         ends = (
@@ -722,9 +779,9 @@ def cmd_demo(args):
         f"{DEMO_TRAIN_SUBJECTS}",
     )
     start = time.perf_counter()
-    pipe.fit(train.X, train.y)
+    pipe.fit(train.X, train.y, fps=data.fps)
     seconds = time.perf_counter() - start
-    y_pred = _predict(args, pipe, test.X)
+    y_pred = _predict(args, pipe, test.X, rates=_input_rates(args, test, "precog"))
     scores = _scores(test, "precog", y_pred, _target_names(data))
     _print_scores(
         scores,

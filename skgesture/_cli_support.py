@@ -414,6 +414,82 @@ def _frame_rate(args, data, kind, info=None, i=None):
     return fps if fps else (float(model_fps) if model_fps else None)
 
 
+def _input_rates(args, data, kind):
+    """The frame rate of every sequence, for the model; None where unknown.
+
+    ``--fps`` when given (it also replaces the data's, :func:`_load_data`); else
+    the rate the data know (PRECOG's, the synthetic streams', ChaLearn's data
+    files, one per sequence), except for your own recordings, whose loader only
+    assumes 30 fps: for them nothing is known (None), and the model takes the
+    frames as they come.
+    """
+    n = len(data.X)
+    if getattr(args, "fps", None):
+        return [float(args.fps)] * n
+    fps = data.get("fps")
+    if kind == "recordings" or fps is None:
+        return None
+    rates = np.broadcast_to(np.asarray(fps, dtype=float), (n,))
+    return [float(r) if np.isfinite(r) and r > 0 else None for r in rates]
+
+
+def _training_rate(args, data, kind):
+    """The rate ``train`` fits at: the data's one rate (or ``--fps``), else 30."""
+    from skgesture._rate import DEFAULT_FPS, same_rate
+
+    rates = _input_rates(args, data, kind)
+    if rates is None:
+        return float(data.get("fps") or DEFAULT_FPS)
+    known = [r for r in rates if r is not None]
+    if not known:
+        return DEFAULT_FPS
+    if any(not same_rate(r, known[0]) for r in known):
+        raise UsageError(
+            f"the training sequences have different frame rates ({min(known):g} to "
+            f"{max(known):g} fps) and a model has one; train on sequences of one "
+            f"rate, or give --fps"
+        )
+    return known[0]
+
+
+def _model_fps(model, info=None):
+    """The rate a model was trained at: its ``fps_``, else the model file's."""
+    fps = getattr(model, "fps_", None)
+    if fps is None:
+        fps = ((info or {}).get("metadata") or {}).get("fps")
+    return float(fps) if fps and fps > 0 else None
+
+
+def _warn_unknown_rate(args, data, kind, model_fps, what="the model's rate"):
+    """One warning line when no rate is known for recordings whose frame
+    numbers suggest another rate than ``model_fps``.
+
+    Frame numbers that advance by ``k`` per line, with a counter at
+    ``model_fps``, are a recording at ``model_fps / k``.
+    """
+    from skgesture._rate import estimate_fps
+
+    if getattr(args, "fps", None) or kind != "recordings" or not model_fps:
+        return
+    numbers = data.get("frame_numbers") or []
+    for sid, nums in zip(data.get("sample_ids") or [], numbers):
+        if nums is None or len(nums) < 3:
+            continue
+        suggested = estimate_fps(np.asarray(nums, dtype=float) / model_fps)
+        if suggested is None or abs(suggested - model_fps) <= 0.05 * model_fps:
+            continue
+        step = model_fps / suggested
+        warnings.warn(
+            f"{sid}: no frame rate is known (pass --fps), and its frame numbers "
+            f"advance by {step:g} per frame: a recording at {suggested:g} fps if "
+            f"they count frames at {model_fps:g} fps ({what}); its frames are "
+            f"taken as {model_fps:g} fps",
+            UserWarning,
+            stacklevel=2,
+        )
+        return
+
+
 # -- models ----------------------------------------------------------------------
 
 
@@ -598,14 +674,52 @@ def _min_gesture_frames(model):
     return None
 
 
-def _predict(args, model, X, ids=None):
+def _rate_options(model, rates, info=None):
+    """``predict``'s keyword arguments for each sequence: ``{"fps": rate}``
+    where the rate is known and the model knows its own. A model file written
+    before models knew their rate takes the frames as they are, with a warning
+    where its file records another training rate than the data's."""
+    from skgesture._rate import same_rate
+
+    if rates is None:
+        return None
+    if getattr(model, "fps_", None) is None:
+        trained = _model_fps(model, info)
+        other = [
+            r for r in rates if trained and r is not None and not same_rate(r, trained)
+        ]
+        if other:
+            warnings.warn(
+                f"the model was trained at {trained:g} fps and the data are at "
+                f"{other[0]:g} fps, but the model file predates resampling: the "
+                f"data are predicted at their own frames",
+                UserWarning,
+                stacklevel=3,
+            )
+        return None
+    return [{} if r is None else {"fps": r} for r in rates]
+
+
+def _predict(args, model, X, ids=None, rates=None, info=None):
     """Per-frame labels of every sequence, with a progress bar; a recording too
-    short for the model to find any gesture in gets a warning that says so."""
+    short for the model to find any gesture in gets a warning that says so.
+
+    ``rates``: the frame rate of each sequence (None where unknown), passed to
+    the model, which resamples to its own rate (docs/streaming.md, "Frame
+    rates").
+    """
+    from skgesture._rate import RateMap, same_rate
+
+    options = _rate_options(model, rates, info)
     floor = _min_gesture_frames(model)
     if floor is not None:
         n_min, why = floor
         for i, x in enumerate(X):
-            if len(x) < n_min:
+            n = len(x)
+            rate = options[i].get("fps") if options else None
+            if rate is not None and not same_rate(rate, model.fps_):
+                n = RateMap(rate, model.fps_).n_out(n)  # at the model's rate
+            if n < n_min:
                 sid = f"recording {i}" if ids is None else str(ids[i])
                 warnings.warn(
                     f"{sid}: {len(x)} frames, shorter than the {n_min} frames in "
@@ -614,9 +728,10 @@ def _predict(args, model, X, ids=None):
                     UserWarning,
                     stacklevel=2,
                 )
+    options = options or [{}] * len(X)
     return [
-        np.asarray(model.predict([x])[0])
-        for x in _progress(args, X, "predicting", total=len(X))
+        np.asarray(model.predict([x], **kw)[0])
+        for x, kw in zip(_progress(args, X, "predicting", total=len(X)), options)
     ]
 
 

@@ -2,11 +2,10 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from sklearn.pipeline import Pipeline
-
 from skgesture._augment import SkeletonAugmenter
 from skgesture._descriptor._estimator import PoseDescriptor
 from skgesture._features import JointFeatures
+from skgesture._gesture_pipeline import GesturePipeline
 from skgesture._multiscale._classifier import (
     MultiScaleClassifier,
     default_window_network,
@@ -16,12 +15,19 @@ from skgesture._taggers._bilstm import BiLSTMTagger
 from skgesture._taggers._sequence import SequenceTagger
 from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
 
-__all__ = ["make_method_a", "make_method_b", "make_method_c", "make_recommended"]
+__all__ = [
+    "GesturePipeline",
+    "make_method_a",
+    "make_method_b",
+    "make_method_c",
+    "make_recommended",
+]
 
 # docs/method.md §6.3
 WEIGHTS_B = (0.4895, 0.4576, 0.0529)
 THRESHOLD_SHORT_B = 0.6014
 THRESHOLD_LONG_B = 0.6033
+
 
 _DOC_COMMON = """
     Parameters
@@ -73,7 +79,7 @@ def _multiscale_pipeline(
             ),
         ),
     ]
-    return Pipeline(stages)
+    return GesturePipeline(stages)
 
 
 def make_method_a(
@@ -87,7 +93,7 @@ def make_method_a(
     {common}
     Returns
     -------
-    sklearn.pipeline.Pipeline
+    GesturePipeline
         The unfitted pipeline; ``predict`` gives per-frame labels.
 
     Examples
@@ -117,7 +123,7 @@ def make_method_b(
     {common}
     Returns
     -------
-    sklearn.pipeline.Pipeline
+    GesturePipeline
         The unfitted pipeline.
 
     Examples
@@ -181,7 +187,7 @@ def make_method_c(
 
     Returns
     -------
-    sklearn.pipeline.Pipeline
+    GesturePipeline
         The unfitted pipeline; ``predict`` gives per-frame labels.
 
     Examples
@@ -198,13 +204,16 @@ def make_method_c(
         "device": device,
     }
     tagger = BiLSTMTagger.paper(**params) if paper else BiLSTMTagger(**params)
-    return Pipeline([("descriptor", PoseDescriptor(joints=joints)), ("tagger", tagger)])
+    return GesturePipeline(
+        [("descriptor", PoseDescriptor(joints=joints)), ("tagger", tagger)]
+    )
 
 
 def make_recommended(
     *,
     joints="paper11",
     features="joints",
+    lookahead=None,
     memory=None,
     random_state=None,
     verbose=0,
@@ -233,6 +242,17 @@ def make_recommended(
         time warp and noise as the only augmentations; it wins when the
         recordings differ in ways the descriptor is invariant to (the synthetic
         streams of :func:`~skgesture.datasets.make_gesture_streams`).
+    lookahead : int or None, default=None
+        None: the TCN reads whole sequences (the best offline model; live it
+        runs on a trailing window and its events differ from offline ones).
+        An int ``L``: the model that streams exactly: the joint features take
+        their statistics as live (``features__statistics="running"``; the
+        descriptor's live rows are its offline ones already) and
+        the TCN's convolutions are causal, its output for a frame read ``L``
+        frames later (``tagger__lookahead``), so that
+        :class:`~skgesture.streaming.StreamingRecognizer` gives the offline
+        events, ``L`` plus the decoding's look-ahead frames behind. It costs
+        offline accuracy on PRECOG (docs/streaming.md, "Exact streaming").
     memory : None, str or joblib.Memory, default=None
         Cache of the trained network, so that the decoding parameters
         (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``) can
@@ -246,7 +266,7 @@ def make_recommended(
 
     Returns
     -------
-    sklearn.pipeline.Pipeline
+    GesturePipeline
         The unfitted pipeline; ``predict`` gives per-frame labels.
 
     Examples
@@ -258,8 +278,9 @@ def make_recommended(
     """
     if features not in ("joints", "descriptor"):
         raise ValueError(f"features must be 'joints' or 'descriptor', got {features!r}")
+    live = {} if lookahead is None else {"statistics": "running", "fill": "hold"}
     if features == "joints":
-        step = JointFeatures(joints=joints)
+        step = JointFeatures(joints=joints, **live)
         augment = SkeletonAugmenter(
             rotation=20.0, scale=0.15, time_warp=0.2, noise=0.02
         )
@@ -281,9 +302,11 @@ def make_recommended(
         max_epochs=30,
         learning_rate=3e-3,
         augment=augment,
+        lookahead=lookahead,
+        fit_threads="all",
         memory=memory,
         device=device,
         random_state=random_state,
         verbose=verbose,
     )
-    return Pipeline([("features", step), ("tagger", tagger)])
+    return GesturePipeline([("features", step), ("tagger", tagger)])

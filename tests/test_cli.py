@@ -1020,3 +1020,93 @@ def test_a_recording_too_short_for_the_model_gets_a_warning(model_b, held_out):
     assert [len(p) for p in y_pred] == [len(x) for x in X]
     assert not any("long_take" in str(w.message) for w in record)
     assert not y_pred[0].any()  # rest throughout, as the warning says
+
+
+# -- frame rates (issue 17) ------------------------------------------------------
+
+
+def test_models_record_their_rate_and_resample_data_at_another(
+    model_b, held_out, capsys
+):
+    """train fits at the data's rate (synthetic streams: 20 fps); evaluate and
+    predict hand --fps (or the data's rate) to the model, which resamples."""
+    model = load_model(model_b)
+    assert model.fps_ == 20.0
+    status, out, err = run(
+        ["evaluate", model_b, *HELD_OUT, "--fps", "40", "--json", "-q"], capsys
+    )
+    assert status == 0, err
+    y_pred = model.predict(held_out.X, fps=40)
+    want = jaccard_index(held_out.y, y_pred)
+    assert json.loads(out)["jaccard"]["official_2014"] == pytest.approx(want)
+    assert [len(p) for p in y_pred] == [len(x) for x in held_out.X]
+    status, out, _ = run(["evaluate", model_b, *HELD_OUT, "--json", "-q"], capsys)
+    want = jaccard_index(held_out.y, model.predict(held_out.X))  # at 20: as is
+    assert json.loads(out)["jaccard"]["official_2014"] == pytest.approx(want)
+
+
+def test_recordings_whose_frame_numbers_suggest_another_rate_get_a_warning(
+    model_b, held_out, tmp_path, capsys
+):
+    """Own recordings have no known rate: the model takes their frames as they
+    are, and says so when their frame numbers advance by 2 (half its rate)."""
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    x = held_out.X[0][:200]
+    numbers = 2 * np.arange(len(x))[:, None]
+    np.savetxt(folder / "take.csv", np.hstack([numbers, x.reshape(len(x), -1)]),
+               delimiter=",", fmt="%.6g")  # fmt: skip
+    status, _, err = run(["predict", model_b, folder, "-o", tmp_path / "p"], capsys)
+    assert status == 0, err
+    warned = [line for line in err.splitlines() if "warning" in line]
+    assert len(warned) == 1, err
+    assert "take: no frame rate is known (pass --fps)" in warned[0]
+    assert "advance by 2 per frame: a recording at 10 fps" in warned[0]
+    status, _, err = run(
+        ["predict", model_b, folder, "-o", tmp_path / "q", "--fps", "10"], capsys
+    )
+    assert status == 0 and "warning" not in err, err
+
+
+def test_train_learns_background_recordings_as_rest(tmp_path, capsys, monkeypatch):
+    """--background DIR: the folder's recordings (no annotations needed) are
+    training sequences whose every frame is rest; 'synthetic' makes them."""
+    from skgesture._persistence import model_info
+
+    rng = np.random.default_rng(0)
+    folder = tmp_path / "work"
+    folder.mkdir()
+    base = make_gesture_streams(n_sequences=1, n_classes=3, random_state=5).X[0]
+    for k in range(2):  # ordinary motion: a recording's rest pose, jittered
+        x = base[:80] + rng.normal(0, 0.01, size=base[:80].shape)
+        np.savetxt(folder / f"walk{k}.csv", x.reshape(len(x), -1), delimiter=",")
+    seen = {}
+    fit = skgesture.GesturePipeline.fit
+
+    def spy(self, X, y, **kw):
+        seen["X"], seen["y"] = X, y
+        return fit(self, X, y, **kw)
+
+    monkeypatch.setattr(skgesture.GesturePipeline, "fit", spy)
+    path = tmp_path / "bg.skg"
+    with torch.random.fork_rng(devices=[]):
+        status, out, err = run(
+            ["train", *SYNTH, *TINY, "--background", folder,
+             "--background", "synthetic", "-o", path], capsys,
+        )  # fmt: skip
+    assert status == 0, err
+    # 3 gesture streams, then the 2 recordings, then the synthetic ones
+    assert len(seen["X"]) > 5 and [len(x) for x in seen["X"][3:5]] == [80, 80]
+    assert all(not y.any() for y in seen["y"][3:])
+    assert any(y.any() for y in seen["y"][:3])
+    meta = model_info(path)["metadata"]
+    assert meta["background"] == [str(folder), "synthetic"]
+    assert meta["n_background_frames"] == sum(len(x) for x in seen["X"][3:])
+
+
+def test_train_background_folder_must_exist(tmp_path, capsys):
+    status, _, err = run(
+        ["train", *SYNTH, *TINY, "--background", tmp_path / "nope",
+         "-o", tmp_path / "m.skg"], capsys,
+    )  # fmt: skip
+    _assert_one_line_error(status, err, "--background")

@@ -13,6 +13,7 @@ import joblib
 import numpy as np
 import pytest
 import torch
+from _stand_ins import make_cheap_pipeline
 from numpy.testing import assert_array_equal
 from sklearn.base import BaseEstimator, clone
 from sklearn.exceptions import NotFittedError
@@ -30,6 +31,7 @@ from skgesture import (
     SkeletonAugmenter,
     TorchMLPClassifier,
 )
+from skgesture.datasets import make_gesture_streams
 
 
 def _discover_estimators():
@@ -72,6 +74,8 @@ INIT_PARAMS = {
     "VotingTagger": {"estimators": [("a", SequenceTagger(**FAST_TAGGER)),
                                     ("b", SequenceTagger(**FAST_TAGGER))],
                      "random_state": 0},
+    # the cheap Method B of the streaming tests (its steps are cloned by _make)
+    "GesturePipeline": {"steps": make_cheap_pipeline().steps},
 }  # fmt: skip
 
 # Estimators seeding networks through random_state.
@@ -110,7 +114,8 @@ BAD_PARAMS = {
     },
     "JointFeatures": {"joints": "paper12", "velocities": "yes",
                       "accelerations": 1.5, "align": "no", "fill": "cubic",
-                      "stream_stats_window": 0, "stream_warmup": -1},
+                      "statistics": "median", "stream_stats_window": 0,
+                      "stream_warmup": -1},
     "SequenceTagger": {
         "architecture": "rnn", "hidden_sizes": 8, "dropout": 1.0, "tcn_layers": 0,
         "tcn_stages": 0, "smoothing_weight": -1.0, "crop_length": 1,
@@ -121,7 +126,7 @@ BAD_PARAMS = {
         "n_iter_no_change": 0, "smooth_span": 0, "smoothing": "gaussian",
         "min_run": 0, "max_gap": -1, "memory": 3, "device": 0, "n_threads": 0,
         "random_state": "seed", "verbose": "loud", "stream_past": -1,
-        "stream_future": 2.5,
+        "stream_future": 2.5, "lookahead": -1, "fit_threads": "every",
     },
     "VotingTagger": {
         "estimators": "gru", "weights": "equal", "smooth_span": 0,
@@ -150,7 +155,8 @@ OTHER_PARAMS = {
                              "random_state": np.random.RandomState(4), "verbose": 1},
     "JointFeatures": {"joints": ["HipCenter", "Head"], "velocities": False,
                       "accelerations": True, "align": True, "fill": "hold",
-                      "stream_stats_window": 100, "stream_warmup": 5},
+                      "statistics": "running", "stream_stats_window": 100,
+                      "stream_warmup": 5},
     "SkeletonAugmenter": {"rotation": 5.0, "scale": 0.0, "time_warp": 0.5,
                           "noise": 0.1},
     "SequenceTagger": {"architecture": "tcn", "hidden_sizes": [16],
@@ -165,7 +171,8 @@ OTHER_PARAMS = {
                        "smooth_span": 5, "smoothing": "loess", "min_run": 3,
                        "max_gap": 2, "memory": "cache_dir", "device": "cpu",
                        "n_threads": None, "random_state": 7, "verbose": 1,
-                       "stream_past": 64, "stream_future": 4},
+                       "stream_past": 64, "stream_future": 4, "lookahead": 6,
+                       "fit_threads": "all"},
     "VotingTagger": {"estimators": [("x", SequenceTagger(max_epochs=1))],
                      "weights": [2.0], "smooth_span": 3, "smoothing": "loess",
                      "min_run": 2, "max_gap": 1, "n_threads": 2,
@@ -186,6 +193,8 @@ def _make(name, **params):
     params = {
         k: clone(v) if isinstance(v, BaseEstimator) else v for k, v in params.items()
     }
+    if name == "GesturePipeline":  # fresh steps too
+        params["steps"] = [(n, clone(est)) for n, est in params["steps"]]
     return ESTIMATORS[name](**params)
 
 
@@ -222,6 +231,11 @@ def _windows():
     return DynamicPoseWindow(steps=(4, 2)).fit_transform(clips), y
 
 
+def _streams():
+    data = make_gesture_streams(n_sequences=2, n_classes=2, random_state=0)
+    return [x[:400] for x in data.X], [y[:400] for y in data.y]
+
+
 # Different training data: a refit on DATA must forget it.
 OTHER_DATA = {
     "PoseDescriptor": lambda X, y: ([x[::-1] * 1.5 for x in X], None),
@@ -232,6 +246,7 @@ OTHER_DATA = {
     "JointFeatures": lambda X, y: ([x[::-1] * 1.5 for x in X], None),
     "SequenceTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
     "VotingTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
+    "GesturePipeline": lambda X, y: (X[1:], y[1:]),
 }
 
 # (X, y, output method) of every sequence estimator
@@ -244,6 +259,7 @@ DATA = {
     "JointFeatures": lambda: (_skeletons(), None, "transform"),
     "SequenceTagger": lambda: (*_features(), "predict_proba"),
     "VotingTagger": lambda: (*_features(), "predict_proba"),
+    "GesturePipeline": lambda: (*_streams(), "predict_segments"),
 }
 
 

@@ -433,13 +433,13 @@ def test_stream_protocol_module_is_standalone():
 # streams) at the top.
 LAYERS = (
     ("skgesture", "skgesture._version", "skgesture._legacy", "skgesture._stream",
-     "skgesture.layouts", "skgesture.utils"),
+     "skgesture._rate", "skgesture.layouts", "skgesture.utils"),
     ("skgesture._descriptor", "skgesture._nn", "skgesture._augment",
      "skgesture.metrics"),
     ("skgesture._features", "skgesture._segmenter", "skgesture._windows",
      "skgesture._multiscale", "skgesture._taggers"),
-    ("skgesture._pipelines", "skgesture.streaming", "skgesture._persistence",
-     "skgesture.datasets"),
+    ("skgesture._pipelines", "skgesture._gesture_pipeline", "skgesture.streaming",
+     "skgesture._persistence", "skgesture.datasets"),
     ("skgesture._cli", "skgesture._cli_commands", "skgesture._cli_support",
      "skgesture.parallel", "skgesture.plotting", "skgesture.__main__",
      "skgesture.utils._testing"),

@@ -7,22 +7,31 @@ decides come back as :class:`GestureEvent` objects. It knows nothing of the
 stages' internals: any pipeline whose stages implement the protocol streams,
 and each stage's step uses the stage's own offline rules, so the events are
 the rows of ``predict_segments`` on the whole recording (docs/streaming.md,
-"Agreement with offline predict").
+"Agreement with offline predict"). At an input rate other than the model's
+(``fps=``), :class:`skgesture._rate.FrameResampler` comes first, and the events'
+frames are mapped back to the input's (docs/streaming.md, "Frame rates").
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import math
 from dataclasses import dataclass
 from numbers import Integral
 
 import numpy as np
 
+from skgesture._rate import FrameResampler, check_fps, same_rate
 from skgesture._stream import DEFAULT_MAX_BACKFILL, DEFAULT_MAX_PERIOD, stream_frames
 from skgesture.utils._buffers import _concat_rows
 
 __all__ = ["GestureEvent", "StreamingRecognizer"]
 
 MAX_BATCH = 1024  # frames handed to the stages in one step by push_many
+# Input frames added to the delays when resampling: ceil(ratio / 2) + 2, the
+# frame a model-rate frame waits for before it is handed on (the next one must
+# be complete) and the rounding of the map back to input frames
+# (skgesture._rate), ratio being input frames per model-rate frame.
+RESAMPLE_DELAY = 2
 _PROTOCOL = ("stream_init", "stream_step", "stream_flush", "stream_lookahead")
 
 
@@ -128,11 +137,24 @@ class StreamingRecognizer:
         setting is restored after each call); ``None`` leaves torch as it is.
         One thread is fastest for the small networks and never oversubscribes
         a busy machine (docs/design.md §6).
+    fps : float or None, default=None
+        Frame rate of the pushed frames (a live source's ``fps``). When it
+        differs from the rate the pipeline was trained at (its ``fps_``, see
+        :class:`~skgesture.GesturePipeline`), the frames are resampled to
+        that rate before the stages, by the rule of offline
+        ``predict(X, fps=...)``, and the events' frames (``start``, ``end``,
+        ``emitted_at``) are input frames. None: the frames are taken as they
+        come, at the model's rate. ``max_period`` and ``max_backfill`` count
+        frames at the model's rate.
 
     Attributes
     ----------
     delays : dict of str to int
-        Look-ahead of every stage (``stream_lookahead``), in frames.
+        Look-ahead of every stage (``stream_lookahead``), in input frames;
+        when resampling, the stages' look-aheads converted to the input's
+        rate (rounded up) after ``"resample"`` (``ceil(ratio / 2) + 2``
+        frames: a frame at the model's rate waits for the next one, and the
+        rounding between the rates).
     lookahead : int
         Frames between a frame and the moment the last stage sees it: the sum
         of the look-aheads of the stages before the last (11 for Methods A/B
@@ -145,6 +167,9 @@ class StreamingRecognizer:
         Gesture classes of the last stage (rest excluded).
     n_frames_seen : int
         Frames pushed in the current stream.
+    ratio : float
+        Input frames per frame at the model's rate (1.0 without
+        resampling).
 
     See Also
     --------
@@ -219,6 +244,7 @@ class StreamingRecognizer:
         early_decision=False,
         target_names=None,
         n_threads=1,
+        fps=None,
     ):
         self.pipeline = pipeline
         self.max_period = max_period
@@ -226,6 +252,7 @@ class StreamingRecognizer:
         self.early_decision = early_decision
         self.target_names = target_names
         self.n_threads = n_threads
+        self.fps = fps
         self._inspect()
         self.reset()
 
@@ -297,6 +324,11 @@ class StreamingRecognizer:
         if self.n_frames_seen:
             with self._threads():
                 rows = None
+                if self._resampler is not None:  # its last model-rate frame
+                    last = self._resampler.flush()
+                    if last is not None:
+                        rows = stream_frames(last.data, self._n_model)
+                        self._n_model += len(last)
                 for k, (_, stage) in enumerate(self._stages):
                     state = self._states[k]
                     out = None
@@ -308,7 +340,7 @@ class StreamingRecognizer:
                         segments = list(out or []) + list(tail or [])
                     else:
                         rows = _concat_rows([out, tail], (0,))
-        events = self._events(segments)
+        events = self._events(segments, flush=True)
         self.reset()
         return events
 
@@ -331,6 +363,10 @@ class StreamingRecognizer:
     def reset(self):
         """Forget the current stream (nothing is emitted)."""
         self.n_frames_seen = 0
+        self._n_model = 0  # frames handed to the stages (model rate)
+        self._resampler = None
+        if self._rates is not None:
+            self._resampler = FrameResampler(self.fps, self._model_fps)
         self._states = [
             stage.stream_init(**options)
             for (_, stage), options in zip(self._stages, self._options)
@@ -347,6 +383,9 @@ class StreamingRecognizer:
             length.
         """
         out = {}
+        if self._resampler is not None:
+            for key, n in self._resampler.held().items():
+                out[f"resample.{key}"] = int(n)
         for (name, _), state in zip(self._stages, self._states):
             held = getattr(state, "held", None)
             for key, n in (held() if held else {}).items():
@@ -425,7 +464,14 @@ class StreamingRecognizer:
         # Building the states checks the options against every stage.
         for (_, stage), options in zip(stages, self._options):
             stage.stream_init(**options)
-        self.delays = {name: int(est.stream_lookahead) for name, est in stages}
+        self._check_rate()
+        delays = {name: int(est.stream_lookahead) for name, est in stages}
+        if self._rates is not None:  # in input frames
+            delays = {
+                "resample": math.ceil(self.ratio / 2) + RESAMPLE_DELAY,
+                **{k: math.ceil(d * self.ratio) for k, d in delays.items()},
+            }
+        self.delays = delays
         self.lookahead = sum(list(self.delays.values())[:-1])
         self.max_delay = sum(self.delays.values())
         classes = np.asarray(last.classes_)
@@ -440,7 +486,32 @@ class StreamingRecognizer:
                     f"(target_names[k - 1] names class k), got {self.target_names!r}"
                 )
 
+    def _check_rate(self):
+        """The input rate against the pipeline's: set ``_rates`` and ``ratio``."""
+        self._rates, self._model_fps, self.ratio = None, None, 1.0
+        if self.fps is None:
+            return
+        fps = check_fps(self.fps)
+        model_fps = getattr(self.pipeline, "fps_", None)
+        if model_fps is None:
+            raise ValueError(
+                f"fps={fps:g} is given, but the pipeline does not know the rate it "
+                f"was trained at (no fps_): fit a GesturePipeline (make_method_a/b/"
+                f"c, make_recommended) with fit(X, y, fps=...), or leave fps=None"
+            )
+        model_fps = check_fps(model_fps, "the pipeline's fps_")
+        if same_rate(fps, model_fps):
+            return
+        self._model_fps = model_fps
+        self._rates = FrameResampler(fps, model_fps).rates
+        self.ratio = self._rates.ratio
+
     def _threads(self):
+        import contextlib
+        import sys
+
+        if "torch" not in sys.modules:  # no torch network runs (Methods A, B)
+            return contextlib.nullcontext()
         from skgesture._nn._training import torch_threads
 
         return torch_threads(self.n_threads)
@@ -486,7 +557,18 @@ class StreamingRecognizer:
 
     def _ingest(self, frames):
         """Run new frames through every stage; return the events they decide."""
-        rows = stream_frames(frames, self.n_frames_seen)
+        if self._resampler is not None:
+            # Checked before the resampler changes (a refused frame changes
+            # nothing), then the frames at the model's rate that are complete.
+            checked = self._resampler.check(frames)
+            frames_in = len(frames)
+            frames = self._resampler.push(checked, checked=True).data
+            if not len(frames):
+                self.n_frames_seen += frames_in
+                return []
+        else:
+            frames_in = len(frames)
+        rows = stream_frames(frames, self._n_model)
         segments = []
         with self._threads():
             states = list(self._states)
@@ -500,22 +582,49 @@ class StreamingRecognizer:
                     rows = out
         # The first stage validates the frames before changing anything.
         self._states = states
-        self.n_frames_seen += len(frames)
+        self.n_frames_seen += frames_in
+        self._n_model += len(frames)
         return self._events(segments)
 
-    def _events(self, segments):
+    def _input_frames(self, seg, flush):
+        """``(start, end, emitted_at)`` of a segment, in input frames.
+
+        The rule of offline ``predict_segments(X, fps=...)``
+        (:func:`skgesture._rate.segments_back`): the input frames whose nearest
+        model-rate frame is in the segment; an event is emitted at the input
+        frame that completed the model-rate frame deciding it (at a flush, the
+        last frame pushed).
+        """
+        if self._rates is None:
+            return int(seg.start), int(seg.end), int(seg.time)
+        rates, n_in = self._rates, self.n_frames_seen
+        start = int(rates.first_input(int(seg.start))[0])
+        if flush and seg.end >= self._n_model:
+            end = n_in
+        else:
+            end = int(rates.first_input(int(seg.end))[0])
+        if flush:
+            emitted = n_in - 1
+        else:
+            emitted = int(rates.ready_at(int(seg.time)))
+        return min(start, n_in), end, emitted
+
+    def _events(self, segments, flush=False):
         events = []
         for seg in segments:
+            start, end, emitted = self._input_frames(seg, flush)
+            if start >= end:
+                continue  # no input frame takes its label (offline drops it too)
             name = None
             if self.target_names is not None:
                 name = self.target_names[int(seg.label) - 1]
             events.append(
                 GestureEvent(
                     label=int(seg.label),
-                    start=int(seg.start),
-                    end=int(seg.end),
+                    start=start,
+                    end=end,
                     confidence=float(seg.confidence),
-                    emitted_at=int(seg.time),
+                    emitted_at=emitted,
                     name=name,
                 )
             )

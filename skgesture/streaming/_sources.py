@@ -10,10 +10,11 @@ Live sources keep time: each frame carries a timestamp, and a gap in the
 timestamps is frames the sensor or the network lost, which come out as
 untracked (all-zero) frames, the toolkit's convention for "nobody tracked"
 (docs/design.md §1.1), rather than as squeezed time. The rule is
-:class:`_FrameClock`'s, shared by every live source: a frame that comes ``k``
-nominal periods (``round((t - t_previous) * fps)``) after the previous one is
-preceded by ``k - 1`` untracked frames, at most ``MAX_GAP_SECONDS`` worth
-(a longer gap is cut there, with a warning); a frame whose timestamp is not
+:class:`skgesture._rate.FrameClock`'s, shared by every live source and by
+:func:`skgesture._rate.frames_from_timestamps` (recordings): a frame that comes
+``k`` nominal periods (``round((t - t_previous) * fps)``) after the previous
+one is preceded by ``k - 1`` untracked frames, at most ``MAX_GAP_SECONDS``
+worth (a longer gap is cut there, with a warning); a frame whose timestamp is not
 after the previous one (out of order, or a duplicate) is dropped with a warning
 and counted in ``n_out_of_order_``. Input that cannot be read as a frame is
 skipped with a warning that says what was wrong, and counted in
@@ -33,6 +34,7 @@ from numbers import Real
 
 import numpy as np
 
+from skgesture._rate import MAX_GAP_SECONDS, FrameClock
 from skgesture.layouts import KINECT_V1, N_COORDS
 from skgesture.streaming._adapters import (
     KinectV1Adapter,
@@ -50,7 +52,6 @@ __all__ = [
     "LSLSource",
 ]
 
-MAX_GAP_SECONDS = 10.0  # longest gap filled with untracked frames
 MAX_WARNINGS = 10  # warnings of one kind per source; later ones are only counted
 MAX_DATAGRAM = 65_535  # bytes, the largest UDP payload
 UDP_RECEIVE_BUFFER = 1 << 22  # bytes asked of the OS (it may grant less)
@@ -178,37 +179,9 @@ class ReplaySource(SkeletonSource):
 # --------------------------------------------------------------------------
 
 
-class _FrameClock:
-    """The dropped-frame rule of every live source (see the module docstring).
-
-    Parameters
-    ----------
-    fps : float
-        Nominal frame rate.
-    max_gap : float, default=MAX_GAP_SECONDS
-        Longest gap, in seconds, that is filled with untracked frames.
-    """
-
-    def __init__(self, fps, max_gap=MAX_GAP_SECONDS):
-        self.fps = fps
-        self.max_fill = int(round(max_gap * fps))
-        self.last = None
-
-    def gap(self, t):
-        """Untracked frames due before a frame stamped ``t`` (seconds).
-
-        Returns
-        -------
-        tuple of (int, int) or None
-            ``(n_fill, n_cut)``: the untracked frames to yield before the
-            frame, and the ones beyond the cap that are left out; None when the
-            frame must be dropped (``t`` is not after the previous timestamp).
-        """
-        if self.last is not None and not t > self.last:
-            return None
-        n = 0 if self.last is None else max(round((t - self.last) * self.fps) - 1, 0)
-        self.last = t
-        return min(n, self.max_fill), max(n - self.max_fill, 0)
+# The dropped-frame rule (skgesture._rate.FrameClock), shared with
+# skgesture._rate.frames_from_timestamps for recordings with timestamps.
+_FrameClock = FrameClock
 
 
 def _check_fps(fps, what="fps"):
