@@ -200,12 +200,20 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
         yaw, at the price of the orientation's estimation noise).
     fill : {"linear", "hold"}, default="linear"
         Filling of untracked frames before differentiation.
+    statistics : {"sequence", "running"}, default="sequence"
+        ``"sequence"``: offline, the statistics (median trunk length, hip
+        position, hip direction) are the whole sequence's; live, those of a
+        trailing window (``stream_stats_window``), so live rows differ from
+        offline ones. ``"running"``: offline as live, every row is the live
+        step's (:meth:`stream_init`) run over the sequence, with the
+        statistics of the trailing window when the row is final: offline
+        features equal streamed ones, exactly (requires ``fill="hold"``, the
+        live rule for untracked frames).
     stream_stats_window : int, default=600
-        Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
-        the statistics (median trunk length, hip position, hip direction) are
-        those of the last ``stream_stats_window`` tracked frames received
-        when a row is emitted (600: 30 s at 20 fps); offline they are the
-        whole sequence's (docs/streaming.md, "The recommended model").
+        The statistics of a row are those of the last
+        ``stream_stats_window`` tracked frames received when it is emitted
+        (600: 30 s at 20 fps), live, and offline with
+        ``statistics="running"`` (docs/streaming.md, "The recommended model").
     stream_warmup : int, default=0
         Streaming only: the first rows wait until this many frames have
         arrived, so that their statistics rest on more frames (0: no wait; a
@@ -252,6 +260,7 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
         "accelerations": ["boolean"],
         "align": ["boolean"],
         "fill": [StrOptions({"linear", "hold"})],
+        "statistics": [StrOptions({"sequence", "running"})],
         "stream_stats_window": [Interval(Integral, 1, None, closed="left")],
         "stream_warmup": [Interval(Integral, 0, None, closed="left")],
     }
@@ -264,6 +273,7 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
         accelerations=False,
         align=False,
         fill="linear",
+        statistics="sequence",
         stream_stats_window=600,
         stream_warmup=0,
     ):
@@ -272,6 +282,7 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
         self.accelerations = accelerations
         self.align = align
         self.fill = fill
+        self.statistics = statistics
         self.stream_stats_window = stream_stats_window
         self.stream_warmup = stream_warmup
 
@@ -292,6 +303,12 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
             The fitted transformer.
         """
         check_skeletons(X, estimator=self, reset=True)
+        if self.statistics == "running" and self.fill != "hold":
+            raise ValueError(
+                f"statistics='running' computes every row as the live step does, "
+                f"which holds the last tracked frame over untracked ones: set "
+                f"fill='hold' (got fill={self.fill!r})"
+            )
         self.joint_names_, self._joint_index = _joint_names(self.joints)
         n_parts = 1 + self.velocities + self.accelerations
         self.n_features_out_ = len(self.joint_names_) * N_COORDS * n_parts
@@ -319,6 +336,8 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
                 f"{list(names)}); refit the features and every stage after them"
             )
         X = check_skeletons(X, estimator=self, reset=False)
+        if getattr(self, "statistics", "sequence") == "running":
+            return [self._running(seq, index) for seq in X]
         out = []
         for seq in X:
             feats = joint_features(
@@ -336,6 +355,20 @@ class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
                 )
             out.append(feats)
         return out
+
+    def _running(self, seq, index):
+        """The live step's rows of one whole sequence (``statistics="running"``)."""
+        from skgesture._stream import stream_frames
+
+        state = JointFeatureStream(self, index)
+        parts = [state.step(stream_frames(seq, 0)), state.flush()]
+        data = np.concatenate([p.data for p in parts]).astype(np.float32, copy=False)
+        mask = np.concatenate([p.mask for p in parts])
+        if mask.any():
+            return np.ma.MaskedArray(
+                data, mask=np.repeat(mask[:, None], data.shape[1], axis=1)
+            )
+        return data
 
     def set_output(self, *, transform=None):
         """Refuse a DataFrame output: a list of sequences has none.

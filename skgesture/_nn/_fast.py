@@ -4,94 +4,105 @@
 
 import numpy as np
 
+# The activations of MLPModule (skgesture._nn._modules._ACTIVATIONS; a test
+# holds the names equal), in float32 numpy.
+ACTIVATIONS = {
+    "relu": lambda h: np.maximum(h, np.float32(0.0)),
+    "tanh": np.tanh,
+    "sigmoid": lambda h: _sigmoid(h),
+    "leaky_relu": lambda h: np.where(h > 0, h, h * np.float32(0.01)),  # torch's slope
+}
 
-def _module_ops(module):
-    """The layers of a sequential torch module as plain torch functions.
 
-    ``nn.Linear``, ``nn.Tanh``, ``nn.ReLU`` and ``nn.Sigmoid`` become the
-    functions their ``forward`` calls (the same kernels, hence the same
-    numbers), without the module-call machinery that costs more than the
-    arithmetic of one row; any other layer is called as a module. ``None``
-    when the module is not a plain ``Sequential`` network.
+def module_arrays(net):
+    """``{name: float32 ndarray}``: the state of a skorch net's module.
+
+    A :class:`~skgesture._nn._deferred.DeferredNet` (a network of a model file
+    that torch has not been needed for) gives its arrays without torch.
     """
-    import functools
-
-    import torch
-    from torch import nn
-
-    net = getattr(module, "net", None)
-    if not isinstance(net, nn.Sequential) or type(module).forward is not getattr(
-        _mlp_module_type(), "forward", None
-    ):
-        return None
-    ops = []
-    for layer in net:
-        if type(layer) is nn.Linear:
-            # Detached: no autograd bookkeeping, without an inference-mode block.
-            weight = layer.weight.detach()
-            bias = None if layer.bias is None else layer.bias.detach()
-            ops.append(functools.partial(torch.nn.functional.linear,
-                                         weight=weight, bias=bias))  # fmt: skip
-        elif type(layer) is nn.Tanh:
-            ops.append(torch.tanh)
-        elif type(layer) is nn.ReLU:
-            ops.append(torch.relu)
-        elif type(layer) is nn.Sigmoid:
-            ops.append(torch.sigmoid)
-        else:
-            ops.append(layer)
-    return ops
+    arrays = getattr(net, "module_arrays", None)
+    if arrays is not None:
+        return arrays
+    return {
+        name: t.detach().cpu().numpy() for name, t in net.module_.state_dict().items()
+    }
 
 
-def _mlp_module_type():
-    from skgesture._nn._modules import MLPModule
+class MLPProba:
+    """Class probabilities of a fitted :class:`~skgesture.TorchMLPClassifier`, in numpy.
 
-    return MLPModule
+    The forward pass of its :class:`~skgesture._nn._modules.MLPModule` (linear
+    layers and their activations, float32, as torch computes it) and the
+    output map (a sigmoid for two classes, else a softmax), returned as
+    float64 ``(n_samples, n_classes)`` in ``classes_`` order. The same float32
+    products as torch, summed by numpy's BLAS: the probabilities equal the
+    module's to float32 rounding (about 1e-7). It is the classifier's one
+    inference path, offline and live, so a model predicts the same with or
+    without torch imported, and loading a model file for prediction never
+    imports torch.
 
-
-def fast_proba(estimator):
-    """``predict_proba`` of a fitted 2-D classifier, as a fast callable.
-
-    For a :class:`~skgesture.TorchMLPClassifier` on the CPU the network's layers
-    are called directly: the same float32 forward pass and output map as
-    ``predict_proba`` (hence the same numbers), without its per-call input
-    validation and module-call machinery, which cost more than the forward
-    pass of one row. Any other classifier's own ``predict_proba`` is returned.
+    Parameters
+    ----------
+    estimator : TorchMLPClassifier
+        The fitted classifier.
     """
-    import torch
 
-    from skgesture._nn._mlp import TorchMLPClassifier
+    def __init__(self, estimator):
+        from skgesture._nn._defaults import PREDICT_BATCH
 
-    if not isinstance(estimator, TorchMLPClassifier):
-        return estimator.predict_proba
-    module = estimator.net_.module_
-    if next(module.parameters()).device.type != "cpu":
-        return estimator.predict_proba
-    module.eval()
-    ops = _module_ops(module)
-    binary = len(estimator.classes_) == 2
-    if ops is None:
-        ops = [module]
-        context = torch.inference_mode
-    else:
-        import contextlib
+        net = estimator.net_
+        activations = tuple(net.module__activations)
+        arrays = module_arrays(net)
+        self.layers = []
+        for i in range(len(activations) + 1):
+            try:
+                weight = arrays[f"net.{2 * i}.weight"]
+                bias = arrays[f"net.{2 * i}.bias"]
+            except KeyError as exc:
+                raise ValueError(
+                    f"the network of {type(estimator).__name__} has no layer {exc} "
+                    f"(layers: {sorted(arrays)})"
+                ) from None
+            if self.layers and weight.shape[1] != self.layers[-1][0].shape[1]:
+                raise ValueError(
+                    f"layer net.{2 * i} takes {weight.shape[1]} inputs, the layer "
+                    f"before gives {self.layers[-1][0].shape[1]}"
+                )
+            act = ACTIVATIONS[activations[i]] if i < len(activations) else None
+            # (in, out) weights: x @ W.T without a copy per call
+            self.layers.append((weight.T.astype(np.float32, copy=False),
+                                bias.astype(np.float32, copy=False), act))  # fmt: skip
+        n_out = self.layers[-1][0].shape[1]
+        self.binary = len(estimator.classes_) == 2
+        if n_out != (1 if self.binary else len(estimator.classes_)):
+            raise ValueError(
+                f"the network has {n_out} outputs for {len(estimator.classes_)} classes"
+            )
+        self.n_inputs = self.layers[0][0].shape[0]
+        self.batch = PREDICT_BATCH
 
-        context = contextlib.nullcontext  # detached weights: nothing to record
+    def _block(self, x):
+        for weight, bias, act in self.layers:
+            x = x @ weight + bias
+            if act is not None:
+                x = act(x)
+        if self.binary:
+            p = _sigmoid(x[:, 0]).astype(np.float64)
+            return np.column_stack([1.0 - p, p])
+        return _softmax(x).astype(np.float64)
 
-    def proba(X):
-        with context():
-            x = torch.from_numpy(np.ascontiguousarray(X, dtype=np.float32))
-            for op in ops:
-                x = op(x)
-            if binary:
-                p = torch.sigmoid(x).numpy()[:, 0].astype(np.float64)
-                out = np.empty((len(p), 2))
-                out[:, 1] = p
-                np.subtract(1.0, p, out=out[:, 0])
-                return out
-            return torch.softmax(x, dim=1).numpy().astype(np.float64)
-
-    return proba
+    def __call__(self, X):
+        """``(len(X), n_classes)`` probabilities of the rows ``X``."""
+        x = np.asarray(X, dtype=np.float32)
+        if x.ndim != 2 or x.shape[1] != self.n_inputs:
+            raise ValueError(
+                f"expected rows of {self.n_inputs} features, got shape {x.shape}"
+            )
+        if len(x) <= self.batch:
+            return self._block(x)
+        return np.concatenate(
+            [self._block(x[i : i + self.batch]) for i in range(0, len(x), self.batch)]
+        )
 
 
 class RecurrentScorer:
@@ -127,9 +138,6 @@ class RecurrentScorer:
     def __init__(self, module, mean, scale):
         import torch
 
-        def numpy(t):
-            return t.detach().cpu().numpy().astype(np.float32)
-
         module.eval()
         self.mean = mean
         self.scale = scale
@@ -137,7 +145,7 @@ class RecurrentScorer:
         for rnn in module.layers:
             pair = []
             for suffix in ("", "_reverse"):
-                w = {n: numpy(getattr(rnn, f"{n}_l0{suffix}")) for n in
+                w = {n: _to_numpy(getattr(rnn, f"{n}_l0{suffix}")) for n in
                      ("weight_ih", "bias_ih", "weight_hh", "bias_hh")}  # fmt: skip
                 pair.append((w["weight_ih"].T.copy(), w["bias_ih"],
                              w["weight_hh"].T.copy(), w["bias_hh"]))  # fmt: skip
@@ -152,7 +160,10 @@ class RecurrentScorer:
             self.activation = lambda h: np.where(h > 0, h, h * slope)
         else:
             self.activation = lambda h: act(torch.from_numpy(h)).numpy()
-        self.head = (numpy(module.head.weight).T.copy(), numpy(module.head.bias))
+        self.head = (
+            _to_numpy(module.head.weight).T.copy(),
+            _to_numpy(module.head.bias),
+        )
         self.reset()
 
     def reset(self):
@@ -252,24 +263,9 @@ class TemporalConvProba:
     """
 
     def __init__(self, module, mean, scale):
-        def numpy(t):
-            return t.detach().cpu().numpy().astype(np.float32)
-
-        def pointwise(conv):  # a kernel-1 Conv1d as (in, out) weights and bias
-            return numpy(conv.weight)[:, :, 0].T.copy(), numpy(conv.bias)
-
         self.mean = mean
         self.scale = scale
-        self.stages = []
-        for stage in module.stages:
-            layers = []
-            for layer in stage.layers:
-                W = numpy(layer.conv.weight)  # (out, in, 3): taps t - d, t, t + d
-                stacked = np.concatenate([W[:, :, k].T for k in range(3)], axis=0)
-                d = int(layer.conv.dilation[0])
-                bias = numpy(layer.conv.bias)
-                layers.append((d, stacked, bias, *pointwise(layer.mix)))
-            self.stages.append((pointwise(stage.inp), layers, pointwise(stage.out)))
+        self.stages = _tcn_stages(module)  # taps t - d, t, t + d
 
     def __call__(self, rows):
         """``(len(rows), n_classes)`` probabilities of consecutive feature rows."""
@@ -292,6 +288,123 @@ class TemporalConvProba:
                 h = h + (a @ w_mix + b_mix)
             x = h @ w_out + b_out
         return _softmax(x).astype(np.float64)
+
+
+class CausalConvScorer:
+    """Class probabilities of a bounded look-ahead MS-TCN, row by row, in numpy.
+
+    For a :class:`~skgesture._nn._modules.TemporalConvModule` with
+    ``lookahead=L`` (causal convolutions, outputs read ``L`` frames later):
+    every feature row that arrives goes through every layer once, each
+    layer keeping the last ``2d`` rows of its input (zeros before the first
+    frame, as the module's left padding), so the probabilities of frame
+    ``u`` are known once row ``u + L`` has arrived, and they are the
+    module's offline ones (the same float32 arithmetic in numpy: equal to
+    float32 rounding). At the end of the stream ``L`` zero rows are pushed,
+    as the module extends a sequence. A scorer of
+    :class:`~skgesture._taggers._stream.TrailingWindowStream` (``lookback``
+    0: the state is carried).
+
+    Parameters
+    ----------
+    module : TemporalConvModule
+        The fitted network, with an int ``lookahead``.
+    mean, scale : ndarray
+        The tagger's standardisation.
+    """
+
+    lookback = 0
+
+    def __init__(self, module, mean, scale):
+        self.mean = mean
+        self.scale = scale
+        self.lookahead = int(module.lookahead)
+        self.stages = _tcn_stages(module)  # causal taps t - 2d, t - d, t
+        self.reset()
+
+    def reset(self):
+        """A fresh stream: zero history in every layer."""
+        self.history = [
+            [
+                np.zeros((2 * d, stacked.shape[1]), np.float32)
+                for d, stacked, *_ in layers
+            ]
+            for _, layers, _ in self.stages
+        ]
+        self.n_in = 0  # input rows pushed (the zero rows of the end included)
+        self.ended = False
+        self.proba = np.empty((0, self.stages[-1][2][0].shape[1]))  # frames to hand on
+        self.first = 0  # frame of proba[0]
+
+    def _push(self, x):
+        """Standardised rows ``x`` through the network; their outputs kept."""
+        for s, ((w_in, b_in), layers, (w_out, b_out)) in enumerate(self.stages):
+            if s:
+                x = _softmax(x)  # a refinement stage reads probabilities
+            h = x @ w_in + b_in
+            for k, (d, stacked, bias, w_mix, b_mix) in enumerate(layers):
+                full = np.concatenate([self.history[s][k], h])
+                m = len(h)
+                taps = np.concatenate(
+                    [full[:m], full[d : d + m], full[2 * d :]], axis=1
+                )
+                a = taps @ stacked + bias
+                np.maximum(a, 0.0, out=a)
+                self.history[s][k] = full[m:]
+                h = h + (a @ w_mix + b_mix)
+            x = h @ w_out + b_out
+        # output row j is frame j - lookahead
+        skip = max(self.lookahead - self.n_in, 0)
+        self.n_in += len(x)
+        self.proba = np.concatenate([self.proba, _softmax(x[skip:]).astype(np.float64)])
+
+    def __call__(self, X, lo, stop, end):
+        """Probabilities of frames ``lo .. stop - 1`` (``lo`` the next one);
+        rows up to ``end - 1`` are read, and when the last frame asked for
+        needs rows past ``end - 1`` the stream has ended there."""
+        real = self.n_in - (self.lookahead if self.ended else 0)
+        if end > real:
+            if self.ended:
+                raise ValueError("rows pushed after the end of the stream")
+            rows = X.data(real, end)
+            self._push(((rows - self.mean) / self.scale).astype(np.float32))
+        need = stop + self.lookahead - self.n_in
+        if need > 0:  # the end of the stream: the module's zero rows
+            self.ended = True
+            width = self.stages[0][0][0].shape[0]
+            self._push(np.zeros((self.lookahead, width), np.float32))
+        if lo != self.first:
+            raise IndexError(f"frames scored out of order: {lo}, expected {self.first}")
+        out = self.proba[: stop - lo]
+        self.proba = self.proba[stop - lo :]
+        self.first = stop
+        return out
+
+
+def _to_numpy(t):
+    return t.detach().cpu().numpy().astype(np.float32)
+
+
+def _pointwise(conv):
+    """A kernel-1 ``Conv1d`` as ``(in, out)`` weights and its bias."""
+    return _to_numpy(conv.weight)[:, :, 0].T.copy(), _to_numpy(conv.bias)
+
+
+def _tcn_stages(module):
+    """The weights of a TemporalConvModule's stages, for numpy: per stage its
+    input map, its layers ``(dilation, stacked taps (3 * in, out), bias, mix
+    weights, mix bias)`` and its output map."""
+    stages = []
+    for stage in module.stages:
+        layers = []
+        for layer in stage.layers:
+            W = _to_numpy(layer.conv.weight)  # (out, in, 3): the three taps
+            stacked = np.concatenate([W[:, :, k].T for k in range(3)], axis=0)
+            d = int(layer.conv.dilation[0])
+            bias = _to_numpy(layer.conv.bias)
+            layers.append((d, stacked, bias, *_pointwise(layer.mix)))
+        stages.append((_pointwise(stage.inp), layers, _pointwise(stage.out)))
+    return stages
 
 
 def _softmax(x):

@@ -133,25 +133,63 @@ class RecurrentTaggerModule(nn.Module):
         return self.head(out)
 
 
-class _DilatedResidual(nn.Module):
-    def __init__(self, dilation, channels, dropout):
+class MaskDropout(nn.Module):
+    """``nn.Dropout`` drawn as one uniform tensor and a comparison.
+
+    The same distribution (each value zeroed with probability ``p``, the
+    others scaled by ``1 / (1 - p)``), from ``torch.rand_like``: on the CPU
+    torch's dropout draws a Bernoulli value at a time, ten times slower than
+    the convolution it follows (it was the largest cost of training the
+    recommended model). The identity in eval mode.
+    """
+
+    def __init__(self, p=0.5):
         super().__init__()
-        self.conv = nn.Conv1d(
-            channels, channels, KERNEL, padding=dilation, dilation=dilation
-        )
-        self.mix = nn.Conv1d(channels, channels, 1)
-        self.dropout = nn.Dropout(dropout)
+        self.p = float(p)
 
     def forward(self, x):
-        return x + self.dropout(self.mix(F.relu(self.conv(x))))
+        if not self.training or self.p == 0.0:
+            return x
+        if self.p >= 1.0:
+            return torch.zeros_like(x)
+        keep = torch.rand_like(x) >= self.p
+        return x * keep * (1.0 / (1.0 - self.p))
+
+
+class _DilatedResidual(nn.Module):
+    """A dilated residual layer: taps ``t - d, t, t + d``, or with ``causal``
+    ``t - 2d, t - d, t`` (zeros before the first frame)."""
+
+    causal = False  # (modules pickled before causal layers existed)
+
+    def __init__(self, dilation, channels, dropout, causal=False):
+        super().__init__()
+        self.causal = causal
+        self.conv = nn.Conv1d(
+            channels,
+            channels,
+            KERNEL,
+            padding=0 if causal else dilation,
+            dilation=dilation,
+        )
+        self.mix = nn.Conv1d(channels, channels, 1)
+        self.dropout = MaskDropout(dropout)
+
+    def forward(self, x):
+        if self.causal:
+            d = self.conv.dilation[0]
+            a = self.conv(F.pad(x, ((KERNEL - 1) * d, 0)))
+        else:
+            a = self.conv(x)
+        return x + self.dropout(self.mix(F.relu(a)))
 
 
 class _Stage(nn.Module):
-    def __init__(self, n_inputs, n_outputs, channels, n_layers, dropout):
+    def __init__(self, n_inputs, n_outputs, channels, n_layers, dropout, causal=False):
         super().__init__()
         self.inp = nn.Conv1d(n_inputs, channels, 1)
         self.layers = nn.ModuleList(
-            _DilatedResidual(2**k, channels, dropout) for k in range(n_layers)
+            _DilatedResidual(2**k, channels, dropout, causal) for k in range(n_layers)
         )
         self.out = nn.Conv1d(channels, n_outputs, 1)
 
@@ -180,12 +218,32 @@ class TemporalConvModule(nn.Module):
         The first stage plus refinement stages.
     dropout : float, default=0.3
         Drop probability inside the residual layers.
+    lookahead : int or None, default=None
+        None: every convolution reads ``t - d, t, t + d`` (the output of a
+        frame depends on frames far on both sides: whole sequences). An int
+        ``L``: every convolution is causal (``t - 2d, t - d, t``) and the
+        output of frame ``t`` is read ``L`` frames later, so that it depends
+        on the frames up to ``t + L`` and on no later one; the input is
+        extended by ``L`` zero rows at its end (the stream's end does the
+        same). Such a network streams exactly, ``L`` frames behind
+        (:class:`~skgesture._nn._fast.CausalConvScorer`).
     """
 
+    lookahead = None  # (modules pickled before the look-ahead existed)
+
     def __init__(
-        self, n_inputs, n_outputs, channels=64, n_layers=8, n_stages=2, dropout=0.3
+        self,
+        n_inputs,
+        n_outputs,
+        channels=64,
+        n_layers=8,
+        n_stages=2,
+        dropout=0.3,
+        lookahead=None,
     ):
         super().__init__()
+        self.lookahead = lookahead
+        causal = lookahead is not None
         self.stages = nn.ModuleList(
             _Stage(
                 n_inputs if k == 0 else n_outputs,
@@ -193,17 +251,22 @@ class TemporalConvModule(nn.Module):
                 channels,
                 n_layers,
                 dropout,
+                causal,
             )
             for k in range(n_stages)
         )
 
     def forward(self, X):
-        out = self.stages[0](X.transpose(1, 2))
+        x = X.transpose(1, 2)
+        if self.lookahead:
+            x = F.pad(x, (0, self.lookahead))
+        out = self.stages[0](x)
         outputs = [out]
         for stage in self.stages[1:]:
             out = stage(F.softmax(out, dim=1))
             outputs.append(out)
-        return tuple(o.transpose(1, 2) for o in outputs)
+        L = self.lookahead or 0
+        return tuple(o[:, :, L:].transpose(1, 2) for o in outputs)
 
 
 _ACTIVATIONS = {

@@ -23,15 +23,11 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
-from skgesture._nn._training import (
-    IGNORE_INDEX,
-    fit_cached,
-    seed_from,
-    torch_threads,
-)
+from skgesture._nn._training import IGNORE_INDEX, torch_threads
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._taggers._decoding import SMOOTHINGS, decode, segments_with_confidence
 from skgesture._taggers._stream import TrailingWindowStream
+from skgesture.utils._fitting import fit_cached, seed_from
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -106,7 +102,14 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
 
     def _fit_network(self, X, y_idx, classes):
         network = self._network(len(classes))
-        with torch_threads(self.n_threads):
+        threads = getattr(self, "fit_threads", None)
+        if threads is None:
+            threads = self.n_threads
+        elif threads == "all":
+            import os
+
+            threads = os.cpu_count() or 1
+        with torch_threads(threads):
             fitted = fit_cached(self.memory, network, X, y_idx)
         self.classes_ = classes
         self._adopt(fitted)
@@ -270,7 +273,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             scorer,
             self.classes_,
             past,
-            getattr(self, "stream_future", DEFAULT_STREAM_FUTURE),
+            self._stream_future(),
             self.smooth_span,
             self.min_run,
             smoothing=self.smoothing,
@@ -288,10 +291,14 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         """
         from skgesture._taggers._decoding import make_smoother
 
-        future = getattr(self, "stream_future", DEFAULT_STREAM_FUTURE)
+        future = self._stream_future()
         name = f"{type(self).__name__}.smooth_span"
         h = make_smoother(self.smoothing, self.smooth_span, 1, owner=name).h
         return int(future) + h + int(self.max_gap) + 1
+
+    def _stream_future(self):
+        """Frames after a frame that its probabilities wait for, live."""
+        return int(getattr(self, "stream_future", DEFAULT_STREAM_FUTURE))
 
     def _training_params(self):
         """The parameters of the training loop every tagger's network takes

@@ -1,0 +1,219 @@
+"""A bounded look-ahead model streams exactly what it predicts offline.
+
+``JointFeatures(statistics="running")`` computes offline rows as the live
+step does, and ``SequenceTagger(architecture="tcn", lookahead=L)`` is a
+network whose frame ``t`` depends on no frame after ``t + L``; with both, the
+stream's events are the offline segments, to the frame.
+"""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.pipeline import Pipeline
+
+torch = pytest.importorskip("torch")
+
+from skgesture import JointFeatures, SequenceTagger  # noqa: E402
+from skgesture._nn._fast import CausalConvScorer  # noqa: E402
+from skgesture._nn._modules import (  # noqa: E402
+    MaskDropout,
+    TemporalConvModule,
+    frame_probabilities,
+)
+from skgesture._stream import stream_frames  # noqa: E402
+from skgesture.datasets import make_gesture_streams  # noqa: E402
+from skgesture.streaming import StreamingRecognizer  # noqa: E402
+from skgesture.utils._buffers import RowBuffer  # noqa: E402
+from skgesture.utils._testing import make_skeleton_stream  # noqa: E402
+
+L = 5
+
+
+def _module(lookahead=L, stages=2):
+    torch.manual_seed(0)
+    return TemporalConvModule(
+        4, 3, channels=8, n_layers=4, n_stages=stages, lookahead=lookahead
+    ).eval()
+
+
+@pytest.mark.parametrize("lookahead", [0, 1, L])
+def test_no_frame_depends_on_frames_after_its_lookahead(lookahead):
+    module = _module(lookahead)
+    x = torch.randn(1, 50, 4)
+    changed = x.clone()
+    changed[0, 30:] = torch.randn(20, 4)
+    with torch.no_grad():
+        a, b = module(x)[-1][0], module(changed)[-1][0]
+    assert a.shape == (50, 3)
+    last = 30 - lookahead  # the first frame that sees frame 30
+    assert torch.equal(a[:last], b[:last])
+    assert not torch.allclose(a[last], b[last])
+
+
+def test_whole_sequence_tcn_sees_the_future():
+    module = _module(None)
+    x = torch.randn(1, 50, 4)
+    changed = x.clone()
+    changed[0, 45:] = torch.randn(5, 4)
+    with torch.no_grad():
+        assert not torch.allclose(module(x)[-1][0, 35], module(changed)[-1][0, 35])
+
+
+@pytest.mark.parametrize("stages", [1, 3])
+def test_the_numpy_stream_scorer_equals_the_module(stages):
+    module = _module(L, stages)
+    X = np.random.default_rng(0).normal(size=(70, 4))
+    mean, scale = X.mean(axis=0), X.std(axis=0)
+    want = frame_probabilities(module, ((X - mean) / scale)[None].astype(np.float32))
+    scorer = CausalConvScorer(module, mean, scale)
+    rows = RowBuffer((4,), capacity=8)
+    got, done = [], 0
+    for t in range(len(X)):
+        rows.append(X[t : t + 1], np.zeros(1, bool), np.array([t]))
+        for u in range(done, rows.stop - L):  # frame u is final with row u + L
+            got.append(scorer(rows, u, u + 1, u + L + 1))
+            done = u + 1
+    got.append(scorer(rows, done, len(X), len(X)))  # the end: zero rows
+    assert_allclose(np.concatenate(got), want[0], rtol=0, atol=1e-6)
+    with pytest.raises(ValueError, match="after the end"):
+        rows.append(X[:1], np.zeros(1, bool), np.array([70]))
+        scorer(rows, len(X), len(X) + 1, len(X) + 1)
+
+
+def test_running_statistics_give_the_live_rows_offline():
+    X, _ = make_skeleton_stream(random_state=0)
+    X = X.copy()
+    X[40:55] = 0.0  # untracked frames
+    feats = JointFeatures(statistics="running", fill="hold").fit([X])
+    offline = feats.transform([X])[0]
+    state = feats.stream_init()
+    parts = []
+    for t in range(len(X)):
+        rows, state = feats.stream_step(state, stream_frames(X[t : t + 1], t))
+        parts.append(rows)
+    rows, state = feats.stream_flush(state)
+    parts.append(rows)
+    live = np.concatenate([p.data for p in parts])
+    assert_array_equal(np.ma.getdata(offline), live)
+    assert_array_equal(np.ma.getmaskarray(offline)[:, 0], np.concatenate(
+        [p.mask for p in parts]))  # fmt: skip
+    # and differ from the whole-sequence statistics
+    whole = JointFeatures(fill="hold").fit([X]).transform([X])[0]
+    assert not np.allclose(np.ma.getdata(whole), live)
+
+
+def test_running_statistics_need_the_live_fill():
+    X, _ = make_skeleton_stream(random_state=0)
+    with pytest.raises(ValueError, match="fill='hold'"):
+        JointFeatures(statistics="running").fit([X])
+
+
+def test_lookahead_is_for_the_tcn_only():
+    X = [np.random.default_rng(0).normal(size=(30, 6))]
+    y = [np.r_[np.zeros(15, int), np.ones(15, int)]]
+    with pytest.raises(ValueError, match="architecture='tcn'"):
+        SequenceTagger(architecture="gru", lookahead=4).fit(X, y)
+
+
+@pytest.fixture(scope="module")
+def exact_model():
+    data = make_gesture_streams(
+        n_sequences=6, n_classes=3, n_gestures=(3, 4), random_state=0
+    )
+    pipe = Pipeline(
+        [
+            ("features", JointFeatures(statistics="running", fill="hold")),
+            (
+                "tagger",
+                SequenceTagger(
+                    architecture="tcn",
+                    hidden_sizes=(16,),
+                    tcn_layers=5,
+                    lookahead=L,
+                    max_epochs=4,
+                    steps_per_epoch=10,
+                    crop_length=96,
+                    smooth_span=5,
+                    min_run=5,
+                    random_state=0,
+                ),
+            ),
+        ]
+    )
+    with torch.random.fork_rng(devices=[]):
+        pipe.fit(data.X[:4], data.y[:4])
+    return pipe, data.X[4:]
+
+
+def test_streamed_events_are_the_offline_segments(exact_model):
+    pipe, X = exact_model
+    found = 0
+    for x in X:
+        segments = pipe[-1].predict_segments(pipe[:-1].transform([x]))[0]
+        events = StreamingRecognizer(pipe).recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))
+        assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
+        found += len(events)
+    assert found > 0
+
+
+def test_the_delay_is_the_lookahead_and_the_decoding(exact_model):
+    pipe, X = exact_model
+    tagger = pipe[-1]
+    h = (tagger.smooth_span - 1) // 2  # the mean smoothing's half span
+    assert tagger.stream_lookahead == L + h + tagger.max_gap + 1
+    events = StreamingRecognizer(pipe).recognize(X[0])
+    features = pipe[0].stream_lookahead
+    assert max(e.emitted_at - (e.end - 1) for e in events) <= (
+        features + tagger.stream_lookahead
+    )
+
+
+def test_mask_dropout_is_dropout():
+    drop = MaskDropout(0.3)
+    x = torch.ones(200_000)
+    torch.manual_seed(0)
+    y = drop.train()(x)
+    assert abs(float((y == 0).float().mean()) - 0.3) < 0.01
+    assert torch.allclose(y[y != 0], torch.tensor(1 / 0.7))
+    assert torch.equal(drop.eval()(x), x)
+    assert torch.equal(MaskDropout(0.0).train()(x), x)
+
+
+def test_make_recommended_with_a_lookahead_streams_exactly():
+    from skgesture import make_recommended
+
+    data = make_gesture_streams(
+        n_sequences=5, n_classes=3, n_gestures=(3, 4), random_state=1
+    )
+    model = make_recommended(joints="full20", lookahead=4, random_state=0)
+    assert model.named_steps["features"].statistics == "running"
+    model.set_params(
+        tagger__hidden_sizes=(8,), tagger__tcn_layers=4, tagger__tcn_stages=2,
+        tagger__max_epochs=3, tagger__steps_per_epoch=5, tagger__crop_length=64,
+    )  # fmt: skip
+    with torch.random.fork_rng(devices=[]):
+        model.fit(data.X[:4], data.y[:4])
+    x = data.X[4]
+    segments = model[-1].predict_segments(model[:-1].transform([x]))[0]
+    events = StreamingRecognizer(model).recognize(x)
+    got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+    assert_array_equal(got, segments[:, :3].astype(int))
+
+
+def test_same_seed_same_predictions_when_training_on_two_threads():
+    X = [np.random.default_rng(k).normal(size=(60, 6)) for k in range(3)]
+    y = [np.r_[np.zeros(20, int), np.ones(20, int), np.zeros(20, int)]] * 3
+
+    def fit():
+        tagger = SequenceTagger(
+            architecture="tcn", hidden_sizes=(8,), tcn_layers=3, max_epochs=2,
+            steps_per_epoch=4, crop_length=32, dropout=0.2, fit_threads=2,
+            random_state=0,
+        )  # fmt: skip
+        with torch.random.fork_rng(devices=[]):
+            return tagger.fit(X, y).predict_proba(X)
+
+    for a, b in zip(fit(), fit()):
+        assert_array_equal(a, b)
