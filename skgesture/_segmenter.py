@@ -10,11 +10,10 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
-from skgesture._nn._fast import fast_proba
-from skgesture._nn._mlp import TorchMLPClassifier
-from skgesture._nn._training import fit_inner_estimator
+from skgesture._nn._mlp import TorchMLPClassifier, fast_proba
 from skgesture._stream import Rows, StreamableMixin
 from skgesture.utils._buffers import RowBuffer, _concat_rows
+from skgesture.utils._fitting import fit_inner_estimator
 from skgesture.utils._segments import remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, loess_smooth
 from skgesture.utils._validation import (
@@ -47,7 +46,9 @@ def context_mask(y, n_context):
     """Training frames of the segmenter in one sequence (docs/method.md §4.1).
 
     Every gesture frame, plus up to ``n_context`` rest frames right before and
-    right after each gesture (all rest frames when ``n_context`` is None).
+    right after each gesture (all rest frames when ``n_context`` is None). A
+    sequence without any gesture is a background recording (ordinary motion,
+    no command in it): all its frames are taken, as negatives.
 
     Parameters
     ----------
@@ -67,9 +68,11 @@ def context_mask(y, n_context):
     >>> from skgesture._segmenter import context_mask
     >>> context_mask(np.array([0, 0, 0, 5, 5, 0, 0, 0]), 2).astype(int).tolist()
     [0, 1, 1, 1, 1, 1, 1, 0]
+    >>> context_mask(np.zeros(4, int), 2).astype(int).tolist()  # background
+    [1, 1, 1, 1]
     """
     gesture = y > 0
-    if n_context is None:
+    if n_context is None or not gesture.any():
         return np.ones_like(gesture)
     keep = gesture.copy()
     starts, ends, vals = runs(gesture)
@@ -104,7 +107,8 @@ class ActivitySegmenter(
         (tanh) - 1 (sigmoid), trained with scaled conjugate gradient.
     n_context : int or None, default=10
         Rest frames taken as negatives before and after each gesture; ``None``
-        takes every rest frame (decision D13).
+        takes every rest frame (decision D13). Every frame of a background
+        sequence (one without gestures) is taken whatever ``n_context`` is.
     threshold : float, default=0.4
         A frame is active when its smoothed score exceeds this.
     min_length : int, default=12
@@ -149,6 +153,15 @@ class ActivitySegmenter(
     score 0, so it is never active. The smoothing still runs over the
     network's output on every frame, so the scores of tracked frames are
     those of the paper's pipeline. ``fit`` trains on every frame, as before.
+
+    Background recordings are training sequences like the others, with every
+    label 0: record a few minutes of ordinary work (no command in it) and add
+    the recordings to ``X`` with all-zero labels in ``y``. All their frames
+    are negatives, so they teach the network that everyday motion is rest;
+    without them the negatives are only the rest frames next to gestures, as
+    in the paper, and the fit is unchanged. A background frame weighs as much
+    as a gesture frame, so a long background shifts the balance towards rest.
+    A fit whose every label is 0 is an error.
 
     Examples
     --------
@@ -204,7 +217,9 @@ class ActivitySegmenter(
         X : list of ndarray of shape (n_frames_i, n_features)
             Per-frame features (e.g. from :class:`PoseDescriptor`).
         y : list of ndarray of shape (n_frames_i,)
-            Per-frame labels; every label > 0 counts as gesture.
+            Per-frame labels; every label > 0 counts as gesture. A sequence
+            whose labels are all 0 is a background recording: all its frames
+            are negatives. At least one gesture frame must occur.
 
         Returns
         -------

@@ -176,6 +176,82 @@ def test_action_map_is_bound_to_the_model_by_the_commander():
     }  # fmt: skip
 
 
+# -- the arming gesture in the file ---------------------------------------------
+
+
+def test_the_file_names_the_arming_gesture(tmp_path):
+    data = {"commands": {"grab": "pick", "release": "place"},
+            "arming": {"class": "wave", "frames": 60}}  # fmt: skip
+    cmap = CommandMap.from_file(_write(tmp_path, data))
+    assert cmap.arming == {"class": "wave", "frames": 60, "disarm_on_command": True}
+    assert CommandMap.from_dict(cmap.to_dict()).to_dict() == cmap.to_dict()
+    text = '[commands]\ngrab = "pick"\nrelease = "place"\n[arming]\nclass = "wave"\n'
+    toml = _write(tmp_path, text + "frames = 60\n", "commands.toml")
+    assert CommandMap.from_file(toml).to_dict() == cmap.to_dict()
+    assert cmap.bind(CLASSES, NAMES).arming_label == 1 and cmap.arming_label is None
+    # ActionMap and the commander take the arming from the map
+    events = [
+        _event(3, 50),  # grab, not armed
+        _event(1, 100),  # wave: armed for 60 frames
+        _event(3, 150),  # pick
+        _event(4, 155),  # disarmed by the last command
+        _event(1, 200),
+        _event(4, 261),  # 61 frames later: too late
+    ]
+    commander = GestureCommander(_Scripted(events), cmap)
+    log = commander.run(range(300))
+    assert [e.command for e in commander.published] == ["pick"]
+    assert log[5][0].reason == "not armed: 61 frames after the arming gesture (> 60)"
+    amap = commander.action_map
+    assert (amap.arming_class, amap.arming_frames, amap.disarm_on_command) == (
+        1, 60, True
+    )  # fmt: skip
+    with pytest.raises(ValueError, match="arming_class given, but the command map"):
+        ActionMap(cmap, arming_class=2)
+    with pytest.raises(ValueError, match="arming_frames given, but the command map"):
+        ActionMap(cmap, arming_frames=30)
+    # a map without arming takes ActionMap's
+    plain = ActionMap(CommandMap({"3": "pick"}), arming_class="wave", arming_frames=30)
+    plain.bind(CLASSES, NAMES)
+    assert plain.arming_class == 1 and plain.arming_frames == 30
+
+
+@pytest.mark.parametrize(
+    "arming, message",
+    [
+        ("wave", r"arming: must be a table"),
+        ({"frames": 30}, r"arming: no 'class': name the arming gesture"),
+        ({"class": "wave", "window": 30}, r"arming: unknown key\(s\) 'window'"),
+        ({"class": "0"}, r"arming\['class'\]: class 0 cannot give a command"),
+        ({"class": "wave", "frames": 0}, r"arming\['frames'\]: must be a positive int"),
+        ({"class": "wave", "frames": 2.5}, r"arming\['frames'\]: must be a positive"),
+        ({"class": "wave", "disarm_on_command": "no"},
+         r"arming\['disarm_on_command'\]: must be true or false"),
+        ({"class": "grab"}, r"arming\['class'\]: class 'grab' is the arming gesture "
+         r"and also gives a command \(commands\['grab'\]\)"),
+    ],
+)  # fmt: skip
+def test_bad_arming_tables_are_refused_when_the_file_is_read(tmp_path, arming, message):
+    path = _write(tmp_path, {"commands": {"grab": "pick"}, "arming": arming})
+    with pytest.raises(ValueError, match=rf"^{re.escape(str(path))}: {message}"):
+        CommandMap.from_file(path)
+
+
+def test_the_arming_class_is_checked_when_bound_to_the_model(tmp_path):
+    path = _write(tmp_path, {"commands": {"grab": "pick"}, "arming": {"class": "9"}})
+    with pytest.raises(
+        ValueError,
+        match=rf"^{re.escape(str(path))}: arming\['class'\]: class 9 is not a class "
+        r"of the model",
+    ):
+        GestureCommander(_Scripted([]), CommandMap.from_file(path))
+    # by number in the file, by name in the commands: the same class
+    clash = CommandMap({"grab": "pick"}, arming={"class": 3})
+    with pytest.raises(ValueError, match=r"class 3 is the arming gesture and also "
+                       r"gives the command 'pick'"):  # fmt: skip
+        clash.bind(CLASSES, NAMES)
+
+
 # -- the state machine --------------------------------------------------------
 
 

@@ -411,6 +411,24 @@ def test_multiscale_rejects_all_rest_labels():
         _clf().fit(_windows(X), [np.zeros_like(lab) for lab in y])
 
 
+def test_multiscale_background_sequences_add_no_window():
+    """A background sequence (all rest) is accepted and changes nothing: the
+    window classifier learns gestures only; the segmenter learns the rest."""
+    X, y = _clips([1, 2, 3, 1, 2, 3])
+    rng = np.random.RandomState(7)
+    background = [_frames(REST_MEAN, 50, rng), _frames(CLASS_MEANS[1], 3, rng)]
+    masked, _ = _stream([(0, 40)])  # as the segmenter hands it on: all masked
+    Xb = _windows(X + background) + _windows([masked])
+    yb = y + [np.zeros(50, int), np.zeros(3, int), np.zeros(40, int)]
+    with_bg = _clf().fit(Xb, yb)
+    alone = _clf().fit(_windows(X), y)
+    assert_array_equal(with_bg.classes_, [1, 2, 3])
+    for a, b in zip(with_bg.estimators_, alone.estimators_):
+        assert_array_equal(a.coef_, b.coef_)
+    with pytest.raises(ValueError, match="no gesture instance"):
+        _clf().fit(Xb[6:], yb[6:])
+
+
 def test_multiscale_rejects_a_single_class():
     X, y = _clips([2, 2])
     with pytest.raises(ValueError, match="single gesture class"):

@@ -18,6 +18,8 @@ from skgesture import (
     TorchMLPClassifier,
     make_method_a,
     make_method_b,
+    make_method_c,
+    make_recommended,
 )
 from skgesture.datasets import make_gesture_streams
 from skgesture.metrics import jaccard_index, jaccard_scorer
@@ -385,3 +387,52 @@ def test_pipeline_feature_names_reach_the_windows(fitted_a):
     descriptor = fitted_a.named_steps["descriptor"].get_feature_names_out()
     assert names[183 + 182] == f"step4_t+0_{descriptor[182]}"
     assert names[-1] == "step4_t+4_dist_HipLeft_HipRight"
+
+
+# --------------------------------------------------------------------------------
+# Background recordings (issue 14)
+# --------------------------------------------------------------------------------
+
+
+def _tiny(make):
+    """A pipeline of ``make`` with tiny networks (its last step's)."""
+    from skgesture import VotingTagger
+
+    pipe = make(random_state=0)
+    if make in (make_method_a, make_method_b):
+        return _small(pipe)
+    name, last = pipe.steps[-1]
+    members = (
+        [f"{name}__{m}" for m, _ in last.estimators]
+        if isinstance(last, VotingTagger)
+        else [name]
+    )
+    tiny = {"hidden_sizes": (8,), "max_epochs": 2}
+    if make is make_recommended:
+        tiny["steps_per_epoch"] = 3
+    return pipe.set_params(**{f"{m}__{k}": v for m in members for k, v in tiny.items()})
+
+
+@pytest.mark.parametrize(
+    "make", [make_method_a, make_method_b, make_method_c, make_recommended]
+)
+def test_every_pipeline_fits_with_background_sequences(make, streams):
+    from skgesture.datasets import make_background
+
+    rng = np.random.RandomState(0)
+    fidget = streams.X[0][:90] + rng.normal(0.0, 0.02, (90, 20, 3))  # no command
+    synthetic = make_background(streams.X, streams.y, n_sequences=2, random_state=0)
+    X = streams.X + [fidget] + synthetic.X
+    y = streams.y + [np.zeros(90, dtype=np.int64)] + synthetic.y
+    n_threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        pipe = _tiny(make).fit(X, y)
+        with pytest.raises(ValueError, match=r"no gesture .*\(every label is 0\)"):
+            clone(pipe).fit(X[4:], y[4:])  # background only
+    finally:
+        torch.set_num_threads(n_threads)
+    classes = pipe.steps[-1][1].classes_
+    assert set(classes.tolist()) - {0} == set(range(1, N_CLASSES + 1))
+    pred = pipe.predict([fidget, streams.X[1]])
+    assert [p.shape for p in pred] == [(90,), streams.y[1].shape]

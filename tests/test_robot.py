@@ -235,3 +235,149 @@ def test_commander_refuses_the_wrong_objects():
     with pytest.raises(TypeError, match="robot must be a PickAndPlaceRobot or None"):
         GestureCommander(rec, amap, robot=object())
     assert GestureCommander(rec, amap, robot=None).robot is None  # publish only
+
+
+# -- the arming gesture -------------------------------------------------------
+
+ARMING = 9  # the attention gesture of these tests
+NOT_ARMED = "not armed: the arming gesture (class 9) comes first"
+
+
+def _armed_map(**params):
+    return ActionMap(
+        {1: "move_to_tool", 2: "close_gripper"}, arming_class=ARMING, **params
+    )
+
+
+def test_a_command_counts_only_in_the_window_after_the_arming_gesture():
+    amap = _armed_map(arming_frames=60)
+    assert amap.arming_frames == 60 and amap.disarm_on_command
+    early = amap.decide(_event(1, 50))
+    assert not early.issued and early.reason == NOT_ARMED
+    assert not amap.is_armed(50)
+    arming = amap.decide(_event(ARMING, 100))
+    assert arming.command is None  # the arming gesture gives no command itself
+    assert arming.reason == "armed: a command is accepted for 60 frames"
+    assert amap.armed_at == 100 and amap.is_armed(160) and not amap.is_armed(161)
+    issued = amap.decide(_event(1, 160))  # the last frame of the window
+    assert issued.command is RobotCommand.MOVE_TO_TOOL
+    # the command disarmed the map: one arming gesture, one command
+    again = amap.decide(_event(2, 165))
+    assert not again.issued and again.reason == NOT_ARMED
+    assert amap.armed_at is None
+    # the window expires
+    amap.decide(_event(ARMING, 300))
+    late = amap.decide(_event(2, 361))
+    assert not late.issued
+    assert late.reason == "not armed: 61 frames after the arming gesture (> 60)"
+    # re-arming opens a new window; so does re-arming before a command
+    amap.decide(_event(ARMING, 400))
+    amap.decide(_event(ARMING, 450))  # restarts the window at 450
+    assert amap.decide(_event(2, 505)).command is RobotCommand.CLOSE_GRIPPER
+    # reset disarms
+    amap.decide(_event(ARMING, 600))
+    amap.reset()
+    assert amap.armed_at is None and amap.decide(_event(1, 650)).reason == NOT_ARMED
+
+
+def test_arming_rules_confidence_refractory_overlap_and_several_commands():
+    amap = _armed_map(min_confidence=0.6, refractory_frames=40, arming_frames=90)
+    weak = amap.decide(_event(ARMING, 10, confidence=0.5))
+    assert weak.reason == "confidence 0.50 < 0.6" and amap.armed_at is None
+    # A command whose gesture starts before the arming gesture ended is the same
+    # motion recognised twice (_event: start = emitted - 40, end = emitted - 12).
+    amap.decide(_event(ARMING, 100))
+    overlap = amap.decide(_event(1, 120))
+    assert not overlap.issued and overlap.reason == (
+        "not armed: the gesture starts at frame 80, before the arming gesture "
+        "ended (frame 88)"
+    )
+    assert amap.decide(_event(1, 128)).issued  # starts at 88: after the end
+    # the refractory period does not hold back the arming gesture
+    amap.decide(_event(ARMING, 130))
+    assert amap.armed_at == 130
+    # without disarm_on_command, every command in the window counts (each after
+    # the refractory period)
+    many = _armed_map(disarm_on_command=False, refractory_frames=20)
+    many.decide(_event(ARMING, 100))
+    decisions = [many.decide(_event(c, t)) for c, t in [(1, 130), (2, 140), (2, 160)]]
+    assert [d.issued for d in decisions] == [True, False, True]
+    assert decisions[1].reason.startswith("refractory")
+    assert many.decide(_event(1, 191)).reason.startswith("not armed: 91 frames")
+
+
+def test_without_an_arming_gesture_every_command_counts():
+    amap = ActionMap({1: "move_to_tool"})
+    assert amap.arming_class is None and amap.is_armed(0)
+    assert amap.decide(_event(1, 10)).issued
+
+
+def test_bad_arming_parameters_are_refused():
+    with pytest.raises(ValueError, match="arming_frames must be a positive int"):
+        _armed_map(arming_frames=0)
+    with pytest.raises(ValueError, match="arming_frames must be a positive int"):
+        _armed_map(arming_frames=2.5)
+    with pytest.raises(ValueError, match="arming_frames must be a positive int"):
+        _armed_map(arming_frames=True)
+    with pytest.raises(ValueError, match="disarm_on_command must be a bool"):
+        _armed_map(disarm_on_command="yes")
+    with pytest.raises(ValueError, match="arming_frames given without arming_class"):
+        ActionMap({1: "move_to_tool"}, arming_frames=30)
+    with pytest.raises(ValueError, match="arming_class: gesture class 0 cannot"):
+        ActionMap({1: "move_to_tool"}, arming_class=0)
+    with pytest.raises(TypeError, match="arming_class: a gesture class must be"):
+        ActionMap({1: "move_to_tool"}, arming_class=1.5)
+    with pytest.raises(ValueError, match="arming_class 1 also gives the command"):
+        ActionMap({1: "move_to_tool"}, arming_class=1)
+    names = ["wave", "point"]
+    with pytest.raises(ValueError, match="arming_class: unknown gesture class name"):
+        ActionMap({1: "move_to_tool"}, arming_class="jump", target_names=names)
+    with pytest.raises(ValueError, match="arming_class 2 also gives the command"):
+        ActionMap({"point": "beep"}, arming_class=2, target_names=names)
+
+
+def test_the_arming_class_is_checked_against_the_model_in_bind():
+    with pytest.raises(
+        ValueError,
+        match=r"^arming_class: class 9 is not a class of the model \(its classes "
+        r"are 1, 2, 3\)",
+    ):
+        _armed_map().bind([1, 2, 3])
+    # a name is resolved by bind, and may not be a mapped class there
+    named = ActionMap({1: "move_to_tool"}, arming_class="wave").bind(
+        [1, 2, 3], target_names=["point", "wave", "grab"]
+    )
+    assert named.arming_class == 2
+    with pytest.raises(ValueError, match="arming_class 1 also gives the command"):
+        ActionMap({1: "move_to_tool"}, arming_class="point").bind(
+            [1, 2], target_names=["point", "wave"]
+        )
+    with pytest.raises(ValueError, match="arming_class: 'wave' is a class name"):
+        ActionMap({1: "move_to_tool"}, arming_class="wave").bind([1, 2])
+    # unbound, a name is matched against the event's name
+    by_name = ActionMap({1: "move_to_tool"}, arming_class="wave")
+    wave = GestureEvent(label=7, start=0, end=9, confidence=0.9, emitted_at=20,
+                        name="wave")  # fmt: skip
+    assert by_name.decide(wave).reason.startswith("armed")
+    assert by_name.decide(_event(1, 60)).issued
+
+
+def test_the_commander_sends_only_armed_commands_to_the_robot():
+    events = [
+        _event(1, 50),  # not armed
+        _event(ARMING, 100),
+        _event(1, 150),  # move_to_tool
+        _event(2, 200),  # disarmed by the last command
+        _event(ARMING, 300),
+        _event(2, 500),  # too late
+        _event(ARMING, 600),
+        _event(2, 650),  # close_gripper
+    ]
+    robot = SimulatedRobot()
+    amap = _armed_map(arming_frames=90)
+    log = GestureCommander(_ScriptedRecognizer(events), amap, robot).run([None] * 700)
+    assert [(d.event.emitted_at, d.issued) for d, _ in log] == [
+        (50, False), (100, False), (150, True), (200, False), (300, False),
+        (500, False), (600, False), (650, True),
+    ]  # fmt: skip
+    assert robot.actions == [RobotCommand.MOVE_TO_TOOL, RobotCommand.CLOSE_GRIPPER]

@@ -29,6 +29,8 @@ CONTEXT_CASES = {
                                          [0, 0, 1, 1, 1, 1, 0, 0]),
     "two_gestures": (([0, 0, 0, 0, 4, 0, 0, 0, 0, 0, 0, 2, 0, 0], 2),
                      [0, 0, 1, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 1]),
+    "background_gives_every_frame": (([0, 0, 0, 0, 0], 1), [1, 1, 1, 1, 1]),
+    "background_with_no_context": (([0, 0, 0], 0), [1, 1, 1]),
 }  # fmt: skip
 
 
@@ -178,8 +180,45 @@ def test_segmenter_score_is_the_frame_accuracy(segmenter, test_stream):
 
 def test_segmenter_rejects_all_rest_labels(train):
     X, y = train
-    with pytest.raises(ValueError, match="no gesture frame"):
-        ActivitySegmenter(_net()).fit([X], [np.zeros_like(y)])
+    with pytest.raises(
+        ValueError, match=r"y has no gesture frame \(every label is 0\)"
+    ):
+        ActivitySegmenter(_net()).fit([X, X[:9]], [np.zeros_like(y), np.zeros(9)])
+
+
+def test_segmenter_takes_every_frame_of_a_background_sequence(train):
+    X, y = train
+    rng = np.random.RandomState(3)
+    background = rng.normal(1.0, 0.5, (37, 3))  # ordinary motion, no gesture
+    keep = context_mask(y, 10)
+    seg = ActivitySegmenter(_RecordingClassifier(), random_state=0)
+    seg.fit([X, background], [y, np.zeros(37, int)])
+    assert_array_equal(seg.estimator_.fit_X_, np.concatenate([X[keep], background]))
+    assert_array_equal(
+        seg.estimator_.fit_y_, np.r_[(y[keep] > 0).astype(int), np.zeros(37, int)]
+    )
+    # Without background, the paper's training frames exactly.
+    alone = ActivitySegmenter(_RecordingClassifier(), random_state=0).fit([X], [y])
+    assert_array_equal(alone.estimator_.fit_X_, X[keep])
+    # Pre-cut clips (no rest at all) train once background gives the rest.
+    gesture = y > 0
+    clips = ActivitySegmenter(_net(), n_context=0, random_state=0)
+    clips.fit([X[gesture], background], [y[gesture], np.zeros(37, int)])
+    assert_array_equal(clips.classes_, [0, 1])
+
+
+def test_segmenter_learns_that_background_motion_is_rest(train):
+    X, y = train
+    rng = np.random.RandomState(4)
+    # motion like the gestures (2.0) on two features, like rest (0.0) on the third
+    motion = rng.normal((2.0, 2.0, 0.0), 0.3, (60, 3))
+    probe = rng.normal((2.0, 2.0, 0.0), 0.3, (40, 3))
+    alone = ActivitySegmenter(_net(), smooth_span=5, random_state=0).fit([X], [y])
+    seg = ActivitySegmenter(_net(), smooth_span=5, random_state=0)
+    seg.fit([X, motion], [y, np.zeros(60, int)])
+    assert alone.predict_proba([probe])[0][:, 1].mean() > 0.5
+    assert seg.predict_proba([probe])[0][:, 1].mean() < 0.1
+    assert _periods(seg.predict([X])[0]) == _periods(y > 0)
 
 
 def test_segmenter_rejects_labels_without_nearby_rest(train):

@@ -390,6 +390,48 @@ def test_voting_tagger_checks_weights(toy):
         VotingTagger([]).fit(X[:2], y[:2])
 
 
+# -- background recordings ---------------------------------------------------------
+
+
+def test_after_training_with_background_random_joint_motion_gives_no_event():
+    """The toy stream of issue 14: a tiny tagger of the recommended kind (joint
+    features, MS-TCN, augmentation), trained with and without background
+    sequences of random joint motion, then run on random joint motion around
+    the rest poses of other subjects."""
+    from sklearn.pipeline import make_pipeline
+
+    from skgesture.datasets import make_background, make_gesture_streams
+    from skgesture.utils import labels_to_segments
+
+    kw = {"n_classes": 3, "n_gestures": (3, 4), "oov_rate": 0.0, "dropout_rate": 0.0}
+    train = make_gesture_streams(6, random_state=0, **kw)
+    test = make_gesture_streams(3, random_state=1, **kw)
+    background = make_background(train.X, train.y, n_sequences=6, n_frames=3000,
+                                 kinds="motion", random_state=0)  # fmt: skip
+    motion = make_background(test.X, test.y, n_sequences=10, kinds="motion",
+                             random_state=1)  # fmt: skip
+
+    def fit(X, y):
+        tagger = SequenceTagger(
+            architecture="tcn", hidden_sizes=(16,), tcn_layers=5, tcn_stages=2,
+            dropout=0.3, smoothing_weight=0.15, crop_length=96, batch_size=8,
+            steps_per_epoch=10, max_epochs=15, min_run=5, random_state=0,
+            augment=SkeletonAugmenter(rotation=20.0, scale=0.15, noise=0.02),
+        )  # fmt: skip
+        return make_pipeline(JointFeatures(), tagger).fit(X, y)
+
+    def n_events(model, X):
+        return sum(len(labels_to_segments(p)) for p in model.predict(X))
+
+    alone = fit(train.X, train.y)
+    assert n_events(alone, motion.X) >= 1  # 3 to 11 events over seeds 0-4
+    model = fit(train.X + background.X, train.y + background.y)
+    assert n_events(model, motion.X) == 0
+    # ... and it still finds the gestures of the held-out streams
+    assert n_events(model, test.X) >= sum(len(s) for s in test.segments) // 2
+    assert jaccard_index(test.y, model.predict(test.X)) > 0.35
+
+
 # -- make_recommended --------------------------------------------------------------
 
 

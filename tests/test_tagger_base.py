@@ -16,7 +16,7 @@ torch = pytest.importorskip("torch")
 
 from sklearn.base import clone  # noqa: E402
 
-from skgesture import BiLSTMTagger, SequenceTagger  # noqa: E402
+from skgesture import BiLSTMTagger, SequenceTagger, VotingTagger  # noqa: E402
 from skgesture._nn._training import (  # noqa: E402
     FramewiseLoss,
     SequenceSplit,
@@ -107,6 +107,53 @@ def test_untracked_rows_count_before_min_run(gesture_everywhere):
     x = np.ones((50, 4), dtype=np.float32)
     x[10:20] = 0.0  # leaves a 10-frame remnant, shorter than min_run
     assert_array_equal(tagger.predict([x])[0], np.r_[[0] * 20, [1] * 30])
+
+
+# -- background recordings ---------------------------------------------------------
+
+# Taggers trained long enough to learn the distractor of _distractors.
+TRAINED = {
+    "bilstm": lambda: BiLSTMTagger(hidden_sizes=(8,), max_epochs=30, random_state=0),
+    "sequence": lambda: SequenceTagger(
+        hidden_sizes=(8,), max_epochs=10, steps_per_epoch=5, crop_length=32,
+        learning_rate=1e-2, random_state=0,
+    ),
+    "voting": lambda: VotingTagger([("a", TRAINED["sequence"]())], random_state=0),
+}  # fmt: skip
+
+
+def _distractors(n=4, seed=1):
+    """Background streams (all rest): the gesture's bump on feature 0, but with
+    feature 1 raised too, a motion that is not the gesture."""
+    X, _ = _streams(n, seed)
+    for x in X:
+        x[20:40, 1] += 1.5
+    return X, [np.zeros(len(x), dtype=np.int64) for x in X]
+
+
+@pytest.mark.parametrize("kind", sorted(TRAINED))
+def test_background_sequences_are_learnt_as_rest(kind):
+    X, y = _streams(4)
+    B, yb = _distractors()
+    test, _ = _distractors(seed=2)
+    gestures, _ = _streams(4, seed=3)
+    alone = TRAINED[kind]().fit(X, y)
+    # Without background the distractor is taken for the gesture ...
+    assert np.mean([(p[20:40] > 0).mean() for p in alone.predict(test)]) > 0.5
+    tagger = TRAINED[kind]().fit(X + B, y + yb)
+    assert_array_equal(tagger.classes_, [0, 1])
+    # ... with it, it is rest, and the gesture is still found.
+    assert all((p == 0).all() for p in tagger.predict(test))
+    assert np.mean([(p[20:40] > 0).mean() for p in tagger.predict(gestures)]) > 0.8
+
+
+@pytest.mark.parametrize("kind", sorted(TRAINED))
+def test_a_fit_with_only_background_is_refused(kind):
+    B, yb = _distractors(2)
+    with pytest.raises(
+        ValueError, match=r"y has no gesture frame \(every label is 0\)"
+    ):
+        TRAINED[kind]().fit(B, yb)
 
 
 @pytest.mark.parametrize("kind", sorted(TAGGERS))

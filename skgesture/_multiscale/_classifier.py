@@ -29,7 +29,6 @@ from skgesture._multiscale._rules import (
 )
 from skgesture._multiscale._stream import MultiScaleStream
 from skgesture._nn._mlp import TorchMLPClassifier
-from skgesture._nn._training import fit_inner_estimator
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._windows import (
     N_POSES,
@@ -38,6 +37,7 @@ from skgesture._windows import (
     check_steps,
     scale_matrix,
 )
+from skgesture.utils._fitting import fit_inner_estimator
 from skgesture.utils._segments import labels_to_segments, runs
 from skgesture.utils._validation import (
     SequenceOf,
@@ -242,7 +242,10 @@ class MultiScaleClassifier(StreamableMixin, ClassifierMixin, BaseEstimator):
             Dynamic poses of every frame (from :class:`DynamicPoseWindow`).
         y : list of ndarray of shape (n_frames_i,)
             Per-frame labels, 0 = rest; each maximal run of one gesture label is
-            a training instance.
+            a training instance. A sequence whose labels are all 0 (a
+            background recording) gives no window: the classifier learns the
+            gesture classes only, and background recordings teach the
+            :class:`ActivitySegmenter` in front of it.
 
         Returns
         -------

@@ -11,6 +11,7 @@ names class ``k``), ``layout`` (``"kinect_v1"``) and ``DESCR``.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from skgesture.datasets._background import make_background
 from skgesture.datasets._base import DataFileWarning, DataFormatError
 from skgesture.datasets._chalearn import (
     CHALEARN_GESTURE_NAMES,
@@ -48,6 +49,7 @@ __all__ = [
     "load_precog",
     "load_recordings",
     "load_utkinect",
+    "make_background",
     "make_gesture_streams",
     "read_chalearn_labels",
     "read_intervals",

@@ -3,7 +3,8 @@
 The paper commands a collaborative robot with five gestures that drive a
 pick-and-place task: move to the tool, close the gripper, carry the tool, open
 the gripper, return home. :class:`ActionMap` turns gesture events into
-commands (confidence floor, refractory period: one gesture, one command);
+commands (confidence floor, refractory period: one gesture, one command;
+optionally an arming gesture before each command);
 :class:`PickAndPlaceRobot` is the task's state machine, which refuses commands
 out of order, with :class:`SimulatedRobot` as a ready-made implementation and
 the place where a real robot plugs in (:meth:`PickAndPlaceRobot._perform`);
@@ -21,7 +22,12 @@ from dataclasses import dataclass
 from enum import Enum
 from numbers import Integral, Real
 
-from skgesture.streaming._commands import CommandEvent, CommandMap, resolve_classes
+from skgesture.streaming._commands import (
+    DEFAULT_ARMING_FRAMES,
+    CommandEvent,
+    CommandMap,
+    resolve_classes,
+)
 
 __all__ = [
     "RobotCommand",
@@ -325,9 +331,24 @@ class ActionMap:
     one gesture, even if it is recognised as two overlapping events, gives
     one command.
 
+    With an arming gesture (``arming_class``), as human-robot interfaces use
+    an attention gesture, a command is accepted only if it is emitted within
+    ``arming_frames`` frames after the event of the arming gesture, and if
+    its gesture starts after the arming gesture ended (an overlapping event
+    is the same motion recognised twice). The arming gesture gives no command
+    itself: it is an error to map its class too. It arms when its confidence
+    reaches ``min_confidence``; the refractory period does not apply to it,
+    and a new arming gesture restarts the window. With ``disarm_on_command``
+    (the default) the command issued disarms the map: one arming gesture,
+    one command, even when the state machine or the robot then refuses the
+    command. Otherwise every command in the window is accepted (each subject
+    to the refractory period). The arming protects against commands given by
+    chance; the model must still reject motion that is not a gesture.
+
     The classes are checked against a model by :meth:`bind`, which
     :class:`GestureCommander` calls with its recogniser's classes: a class the
-    model does not have, or one given twice, is an error then.
+    model does not have, or one given twice, is an error then; so is an
+    arming class the model does not have.
 
     Parameters
     ----------
@@ -347,6 +368,18 @@ class ActionMap:
     target_names : sequence of str or None, default=None
         ``target_names[k - 1]`` names class ``k`` (as the dataset loaders'
         ``target_names``), to write ``mapping`` with class names.
+    arming_class : int, str or None, default=None
+        The arming gesture's class, a label or a name as in ``mapping``; None
+        (and no ``arming`` in the :class:`CommandMap`): every command is
+        accepted without arming, as before.
+    arming_frames : int or None, default=None
+        Frames after the arming gesture's event in which a command is
+        accepted (counted between emission frames); None: 90 (3 s at 30 fps),
+        or the command map's.
+    disarm_on_command : bool or None, default=None
+        Whether an issued command disarms the map; None: True, or the command
+        map's. Given with a command map that sets ``arming``, these three are
+        an error (set the arming in one place).
 
     Attributes
     ----------
@@ -356,6 +389,16 @@ class ActionMap:
         time (until :meth:`bind` resolves them).
     command_map : CommandMap or None
         The map given as ``mapping`` (bound by :meth:`bind`), else None.
+    arming_class : int, str or None
+        The arming gesture's label (its name, until :meth:`bind` resolves a
+        name), or None without arming.
+    arming_frames : int
+        The arming window, in frames.
+    disarm_on_command : bool
+        Whether an issued command disarms the map.
+    armed_at : int or None
+        Emission frame of the arming event that armed the map; None before
+        any, or after a command disarmed it (see :meth:`is_armed`).
 
     Examples
     --------
@@ -372,11 +415,24 @@ class ActionMap:
     >>> by_name = ActionMap({"point": "carry_tool"}, target_names=names)
     >>> by_name.mapping
     {2: <RobotCommand.CARRY_TOOL: 'carry_tool'>}
+
+    With an arming gesture (class 5), a command counts only in the 90 frames
+    after it:
+
+    >>> armed = ActionMap({1: "move_to_tool"}, arming_class=5, arming_frames=90)
+    >>> armed.decide(GestureEvent(1, 0, 30, 0.9, emitted_at=40)).reason
+    'not armed: the arming gesture (class 5) comes first'
+    >>> armed.decide(GestureEvent(5, 50, 80, 0.9, emitted_at=90)).reason
+    'armed: a command is accepted for 90 frames'
+    >>> str(armed.decide(GestureEvent(1, 100, 130, 0.9, emitted_at=140)).command)
+    'move_to_tool'
+    >>> armed.decide(GestureEvent(1, 150, 180, 0.9, emitted_at=190)).reason
+    'not armed: the arming gesture (class 5) comes first'
     """
 
-    def __init__(
-        self, mapping, *, min_confidence=0.0, refractory_frames=0, target_names=None
-    ):
+    def __init__(self, mapping, *, min_confidence=0.0, refractory_frames=0,
+                 target_names=None, arming_class=None, arming_frames=None,
+                 disarm_on_command=None):  # fmt: skip
         if (
             isinstance(min_confidence, bool)
             or not isinstance(min_confidence, Real)
@@ -424,7 +480,67 @@ class ActionMap:
             self.mapping[cls] = _as_command(command)
         self.min_confidence = min_confidence
         self.refractory_frames = refractory_frames
+        self._init_arming(arming_class, arming_frames, disarm_on_command)
         self.reset()
+
+    def _init_arming(self, arming_class, arming_frames, disarm_on_command):
+        """Check and set the arming parameters (or the command map's)."""
+        if arming_frames is not None and (
+            isinstance(arming_frames, bool)
+            or not isinstance(arming_frames, Integral)
+            or arming_frames < 1
+        ):
+            raise ValueError(
+                f"arming_frames must be a positive int or None, got {arming_frames!r}"
+            )
+        if disarm_on_command is not None and not isinstance(disarm_on_command, bool):
+            raise ValueError(
+                f"disarm_on_command must be a bool or None, got {disarm_on_command!r}"
+            )
+        given = {
+            "arming_class": arming_class,
+            "arming_frames": arming_frames,
+            "disarm_on_command": disarm_on_command,
+        }
+        given = [k for k, v in given.items() if v is not None]
+        cmap = self.command_map
+        if cmap is not None and getattr(cmap, "arming", None) is not None:
+            if given:
+                raise ValueError(
+                    f"{', '.join(given)} given, but the command map sets the arming "
+                    f"gesture already ({cmap.arming!r}): set it in one place"
+                )
+            arming = cmap.arming
+            arming_class = cmap.arming_label if cmap.bound else arming["class"]
+            arming_frames = arming["frames"]
+            disarm_on_command = arming["disarm_on_command"]
+        elif arming_class is None and given:
+            raise ValueError(
+                f"{', '.join(given)} given without arming_class: name the arming "
+                f"gesture"
+            )
+        self.arming_frames = (
+            DEFAULT_ARMING_FRAMES if arming_frames is None else int(arming_frames)
+        )
+        self.disarm_on_command = (
+            True if disarm_on_command is None else disarm_on_command
+        )
+        self.arming_class = None
+        if arming_class is not None:
+            try:
+                cls = self._class_key(arming_class)
+            except (TypeError, ValueError) as exc:
+                raise type(exc)(f"arming_class: {exc}") from None
+            self._check_arming_unmapped(cls)
+            self.arming_class = cls
+
+    def _check_arming_unmapped(self, cls):
+        if cls in self.mapping:
+            raise ValueError(
+                f"arming_class {cls!r} also gives the command "
+                f"{str(self.mapping[cls])!r}: the arming gesture gives no command; "
+                f"remove it from the mapping"
+            )
 
     def _class_key(self, key):
         """A key of ``mapping`` as a label (int >= 1) or a name to match."""
@@ -494,11 +610,41 @@ classes are 1, 2, 3, 4)
         else:
             entries = [(k, k, c) for k, c in self.mapping.items()]
             self.mapping = resolve_classes(entries, classes, names)
+        if self.command_map is not None and self.command_map.arming is not None:
+            self.arming_class = self.command_map.arming_label
+        elif self.arming_class is not None:
+            key = self.arming_class
+            (self.arming_class,) = resolve_classes(
+                [(key, key, None)], classes, names, where=lambda k: "arming_class"
+            )
+            self._check_arming_unmapped(self.arming_class)
         return self
 
     def reset(self):
-        """Forget the last issued command."""
+        """Forget the last issued command and disarm."""
         self._last_issued = None
+        self.armed_at = None
+        self._armed_end = None
+
+    def is_armed(self, frame):
+        """Whether a command emitted at ``frame`` would be in the arming window.
+
+        Parameters
+        ----------
+        frame : int
+            A stream frame (e.g. the current one, to show the operator that
+            the robot listens).
+
+        Returns
+        -------
+        bool
+            Always True without an arming gesture.
+        """
+        if self.arming_class is None:
+            return True
+        return self.armed_at is not None and (
+            0 <= frame - self.armed_at <= self.arming_frames
+        )
 
     def decide(self, event):
         """The command for one event, or why there is none.
@@ -519,26 +665,27 @@ classes are 1, 2, 3, 4)
                     f"ActionMap.decide takes a GestureEvent (label, confidence, "
                     f"emitted_at), got {type(event).__name__}"
                 )
-        command = self.mapping.get(int(event.label))
         name = getattr(event, "name", None)
-        if command is None and name is not None:
-            command = self.mapping.get(name)
-        if command is None:
-            what = f"class {event.label}" + (f" ({name})" if name else "")
-            return ActionDecision(event, None, f"{what} has no command")
-        confidence = event.confidence
-        try:
-            number = isinstance(confidence, Real) and math.isfinite(confidence)
-        except TypeError:
-            number = False
-        if not number:
-            return ActionDecision(
-                event, None, f"confidence {confidence!r} is not a finite number"
-            )
-        if not confidence >= self.min_confidence:
+        arming = self.arming_class is not None and self.arming_class in (
+            int(event.label), name
+        )  # fmt: skip
+        command = None
+        if not arming:  # the arming gesture gives no command
+            command = self.mapping.get(int(event.label))
+            if command is None and name is not None:
+                command = self.mapping.get(name)
+            if command is None:
+                what = f"class {event.label}" + (f" ({name})" if name else "")
+                return ActionDecision(event, None, f"{what} has no command")
+        refused = self._refuse_confidence(event.confidence)
+        if refused:
+            return ActionDecision(event, None, refused)
+        if arming:
+            self.armed_at = event.emitted_at
+            self._armed_end = getattr(event, "end", None)
             return ActionDecision(
                 event, None,
-                f"confidence {confidence:.2f} < {self.min_confidence:g}",
+                f"armed: a command is accepted for {self.arming_frames} frames",
             )  # fmt: skip
         if self._last_issued is not None:
             gap = event.emitted_at - self._last_issued
@@ -548,10 +695,49 @@ classes are 1, 2, 3, 4)
                     f"refractory: {gap} frames after the last command "
                     f"(< {self.refractory_frames})",
                 )  # fmt: skip
+        if self.arming_class is not None:
+            refused = self._refuse_unarmed(event)
+            if refused:
+                return ActionDecision(event, None, refused)
+            if self.disarm_on_command:
+                self.armed_at = self._armed_end = None
         self._last_issued = event.emitted_at
         return ActionDecision(event, command, "issued")
 
     __call__ = decide
+
+    def _refuse_confidence(self, confidence):
+        """Why ``confidence`` issues nothing, or None."""
+        try:
+            number = isinstance(confidence, Real) and math.isfinite(confidence)
+        except TypeError:
+            number = False
+        if not number:
+            return f"confidence {confidence!r} is not a finite number"
+        if not confidence >= self.min_confidence:
+            return f"confidence {confidence:.2f} < {self.min_confidence:g}"
+        return None
+
+    def _refuse_unarmed(self, event):
+        """Why a command event is outside the arming window, or None."""
+        if self.armed_at is None:
+            return (
+                f"not armed: the arming gesture (class {self.arming_class}) comes first"
+            )
+        gap = event.emitted_at - self.armed_at
+        if gap > self.arming_frames:
+            return (
+                f"not armed: {gap} frames after the arming gesture "
+                f"(> {self.arming_frames})"
+            )
+        start = getattr(event, "start", None)
+        if self._armed_end is not None and start is not None:
+            if start < self._armed_end:
+                return (
+                    f"not armed: the gesture starts at frame {start}, before the "
+                    f"arming gesture ended (frame {self._armed_end})"
+                )
+        return None
 
 
 def _as_command(value):
@@ -565,13 +751,13 @@ class GestureCommander:
     """Recogniser -> action map -> state machine -> robot and publishers.
 
     Every event of the recogniser goes through the action map (confidence
-    floor, refractory period). An issued command is then checked against the
-    state machine of the map's :class:`CommandMap`, if it has one: a command
-    that is not valid in the current state is rejected (neither executed nor
-    published) and counted in :attr:`n_rejected`. It is executed by the robot,
-    if there is one (which may refuse it too), and, once carried out, the
-    state machine moves on and a :class:`CommandEvent` goes to every
-    ``on_command`` callback.
+    floor, refractory period, arming gesture). An issued command is then
+    checked against the state machine of the map's :class:`CommandMap`, if it
+    has one: a command that is not valid in the current state is rejected
+    (neither executed nor published) and counted in :attr:`n_rejected`. It
+    is executed by the robot, if there is one (which may refuse it too), and,
+    once carried out, the state machine moves on and a :class:`CommandEvent`
+    goes to every ``on_command`` callback.
 
     Parameters
     ----------

@@ -23,7 +23,10 @@ from pathlib import Path
 
 __all__ = ["CommandMap", "CommandEvent", "JSONLinesPublisher", "UDPPublisher"]
 
-_FILE_KEYS = ("commands", "states", "initial")
+_FILE_KEYS = ("commands", "states", "initial", "arming")
+_ARMING_KEYS = ("class", "frames", "disarm_on_command")
+_ARMING_AT = "arming[%r]"  # an entry of the arming table, in messages
+DEFAULT_ARMING_FRAMES = 90  # 3 s at 30 fps: the window after an arming gesture
 MAX_DATAGRAM = 65_507  # the largest UDP payload over IPv4
 
 
@@ -160,6 +163,12 @@ class CommandMap:
         and the state each leads to. None: every command is always valid.
     initial : str or None, default=None
         The state a stream starts in; required with ``states``.
+    arming : dict or None, default=None
+        The arming gesture (see :class:`~skgesture.streaming.ActionMap`):
+        ``{"class": gesture class, "frames": 90, "disarm_on_command": True}``,
+        ``class`` required; a command is then accepted only within ``frames``
+        frames after that gesture. The arming class gives no command, so it
+        must not be a key of ``commands``. None: no arming gesture.
     source : str or None, default=None
         Where the map comes from (a file name), for error messages.
 
@@ -171,8 +180,13 @@ class CommandMap:
         The state machine as given.
     initial : str or None
         The initial state.
+    arming : dict or None
+        ``{"class", "frames", "disarm_on_command"}``, checked and completed
+        with the defaults, or None.
     mapping : dict or None
         ``{label: command}`` once bound (:meth:`bind`), else None.
+    arming_label : int or None
+        The arming gesture's label once bound, else None.
     classes : tuple of int or None
         The model's classes once bound, else None.
 
@@ -193,10 +207,12 @@ class CommandMap:
           "initial": "idle"
         }
 
-    Only these three keys are read; any other key is an error (a misspelt
-    ``"comands"`` would otherwise silently give no commands). In TOML, the
-    same tables: ``initial = "idle"``, ``[commands]`` with ``wave = "stop"``
-    and ``3 = "pick"``, ``[states.idle]`` with ``pick = "holding"``.
+    An optional fourth key, ``"arming": {"class": "raise_hand", "frames":
+    90}``, names the arming gesture. Only these keys are read; any other key
+    is an error (a misspelt ``"comands"`` would otherwise silently give no
+    commands). In TOML, the same tables: ``initial = "idle"``, ``[commands]``
+    with ``wave = "stop"`` and ``3 = "pick"``, ``[states.idle]`` with ``pick =
+    "holding"``, ``[arming]`` with ``class = "raise_hand"``.
 
     Examples
     --------
@@ -220,7 +236,9 @@ class CommandMap:
 class names (target_names); give its class number (1, 2)
     """
 
-    def __init__(self, commands, *, states=None, initial=None, source=None):
+    def __init__(
+        self, commands, *, states=None, initial=None, arming=None, source=None
+    ):
         self.source = None if source is None else str(source)
         if not isinstance(commands, Mapping):
             raise ValueError(
@@ -247,8 +265,10 @@ class names (target_names); give its class number (1, 2)
             self._entries.append((key, cls, _command(command, where)))
         self.vocabulary = list(dict.fromkeys(c for _, _, c in self._entries))
         self.states, self.initial = self._check_states(states, initial)
+        self.arming = self._check_arming(arming, seen)
         self.mapping = None
         self.classes = None
+        self.arming_label = None
 
     def _at(self, key):
         return f"{self.source}: {key}: " if self.source else f"{key}: "
@@ -317,6 +337,48 @@ class names (target_names); give its class number (1, 2)
                 )
         return checked, initial
 
+    def _check_arming(self, arming, seen):
+        """The ``arming`` table, checked and completed with the defaults."""
+        if arming is None:
+            return None
+        if not isinstance(arming, Mapping):
+            raise ValueError(
+                f'{self._at("arming")}must be a table {{"class": gesture class, '
+                f'"frames": int}}, got {arming!r}'
+            )
+        unknown = [k for k in arming if k not in _ARMING_KEYS]
+        if unknown:
+            raise ValueError(
+                f"{self._at('arming')}unknown key(s) {', '.join(map(repr, unknown))}; "
+                f"the arming table has {', '.join(map(repr, _ARMING_KEYS))}"
+            )
+        if "class" not in arming:
+            raise ValueError(
+                f"{self._at('arming')}no 'class': name the arming gesture (a class "
+                f"number or name)"
+            )
+        where = self._at(_ARMING_AT % "class").rstrip(": ")
+        cls = _class_key(arming["class"], where)
+        if cls in seen:
+            raise ValueError(
+                f"{where}: class {cls!r} is the arming gesture and also gives a "
+                f"command (commands[{seen[cls]!r}]); the arming gesture gives no "
+                f"command"
+            )
+        frames = arming.get("frames", DEFAULT_ARMING_FRAMES)
+        if isinstance(frames, bool) or not isinstance(frames, Integral) or frames < 1:
+            raise ValueError(
+                f"{self._at(_ARMING_AT % 'frames')}must be a positive int (frames "
+                f"after the arming gesture), got {frames!r}"
+            )
+        disarm = arming.get("disarm_on_command", True)
+        if not isinstance(disarm, bool):
+            raise ValueError(
+                f"{self._at(_ARMING_AT % 'disarm_on_command')}must be true or "
+                f"false, got {disarm!r}"
+            )
+        return {"class": cls, "frames": int(frames), "disarm_on_command": disarm}
+
     @classmethod
     def from_dict(cls, data, *, source=None):
         """A map from ``{"commands": ..., "states": ..., "initial": ...}``.
@@ -324,8 +386,8 @@ class names (target_names); give its class number (1, 2)
         Parameters
         ----------
         data : dict
-            The contents of a command file; ``states`` and ``initial`` are
-            optional, any other key is an error.
+            The contents of a command file; ``states``, ``initial`` and
+            ``arming`` are optional, any other key is an error.
         source : str or None, default=None
             Where it comes from, for error messages.
 
@@ -344,7 +406,8 @@ class names (target_names); give its class number (1, 2)
         if not isinstance(data, Mapping):
             raise ValueError(
                 f"{prefix}a command file holds a table with 'commands' (and "
-                f"optionally 'states' and 'initial'), got {type(data).__name__}"
+                f"optionally 'states', 'initial' and 'arming'), got "
+                f"{type(data).__name__}"
             )
         unknown = [k for k in data if k not in _FILE_KEYS]
         if unknown:
@@ -358,6 +421,7 @@ class names (target_names); give its class number (1, 2)
             data["commands"],
             states=data.get("states"),
             initial=data.get("initial"),
+            arming=data.get("arming"),
             source=source,
         )
 
@@ -436,7 +500,9 @@ class names (target_names); give its class number (1, 2)
         ------
         ValueError
             For a class name the model does not have, a class number not
-            among its classes, or a class given twice (by name and number).
+            among its classes, or a class given twice (by name and number);
+            the same for the arming gesture, which also must not be a class
+            that gives a command.
 
         Examples
         --------
@@ -453,6 +519,20 @@ classes are 1, 2, 3)
             self._entries, classes, target_names, where=self._where
         )
         bound.classes = tuple(sorted({int(c) for c in classes} - {0}))
+        if self.arming is not None:
+            where = self._at(_ARMING_AT % "class").rstrip(": ")
+            key = self.arming["class"]
+            label = resolve_classes(
+                [(key, key, None)], classes, target_names, where=lambda _: where
+            )
+            (bound.arming_label,) = label
+            if bound.arming_label in bound.mapping:
+                raise ValueError(
+                    f"{where}: class {bound.arming_label} is the arming gesture "
+                    f"and also gives the command "
+                    f"{bound.mapping[bound.arming_label]!r}; the arming gesture "
+                    f"gives no command"
+                )
         return bound
 
     def allowed(self, state):
@@ -505,16 +585,21 @@ classes are 1, 2, 3)
         Returns
         -------
         dict
-            ``{"commands": ...}``, with ``states`` and ``initial`` when set.
+            ``{"commands": ...}``, with ``states``, ``initial`` and
+            ``arming`` when set.
         """
         out = {"commands": {str(k): c for k, _, c in self._entries}}
         if self.states is not None:
             out["states"] = {s: dict(m) for s, m in self.states.items()}
             out["initial"] = self.initial
+        if self.arming is not None:
+            out["arming"] = dict(self.arming)
         return out
 
     def __repr__(self):
         extra = "" if self.states is None else f", initial={self.initial!r}"
+        if self.arming is not None:
+            extra += f", arming={self.arming!r}"
         where = f", source={self.source!r}" if self.source else ""
         return f"CommandMap({self.to_dict()['commands']!r}{extra}{where})"
 
