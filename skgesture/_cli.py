@@ -576,6 +576,23 @@ def _discard_output():
             os.close(null)
 
 
+@contextlib.contextmanager
+def _descriptor_path():
+    """Restore the descriptor's implementation switch, which a command on a
+    few frames turns to numpy (``_cli_support.COMPILED_MIN_FRAMES``)."""
+    name = "skgesture._descriptor._compute"  # not imported here: --help stays light
+    loaded = sys.modules.get(name)
+    before = None if loaded is None else loaded.USE_COMPILED
+    try:
+        yield
+    finally:
+        compute = sys.modules.get(name)
+        if compute is not None:
+            compute.USE_COMPILED = (
+                compute.USE_COMPILED_DEFAULT if before is None else before
+            )
+
+
 def _run(argv):
     parser = build_parser()
     try:
@@ -588,7 +605,7 @@ def _run(argv):
         parser.print_usage(sys.stderr)
         print("skgesture: error: give a command, e.g. skgesture demo", file=sys.stderr)
         return EXIT_USAGE
-    with _warnings_as_lines(), plain_progress(args):
+    with _warnings_as_lines(), plain_progress(args), _descriptor_path():
         try:
             return args.func(args) or 0
         except KeyboardInterrupt:

@@ -370,7 +370,18 @@ def _load_data(args, *, need_labels, need_skeletons=True):
         raise UsageError(f"{name} holds no sequence")
     if need_labels and data.get("y") is None:
         raise UsageError(f"{name} has no annotations (labels) to train or score on")
+    if need_skeletons and _n_frames(data) < COMPILED_MIN_FRAMES:
+        import skgesture._descriptor._compute as compute
+
+        compute.USE_COMPILED = False  # restored when the command ends (_cli._run)
     return data, kind, name
+
+
+# Loading the compiled descriptor kernel (numba) costs about 0.7 s in a fresh
+# process, in which the numpy implementation computes 170,000 frames (250,000
+# a second): a command on fewer frames than this computes the descriptor in
+# numpy (the same descriptor, to 1e-12), for the whole command.
+COMPILED_MIN_FRAMES = 100_000
 
 
 def _n_frames(data):

@@ -225,3 +225,24 @@ def test_the_manifest_records_the_training_rate(data, tmp_path):
     path = save_model(pipe, tmp_path / "b20.skg")
     assert model_info(path)["input"]["fps"] == 20.0
     assert load_model(path).fps_ == 20.0
+
+
+def test_a_short_command_line_evaluation_imports_neither_torch_nor_numba(saved):
+    """The command line computes the descriptor of a few frames in numpy: loading
+    the compiled kernel would cost more than computing them."""
+    script = textwrap.dedent(
+        f"""
+        import sys
+        from skgesture._cli import main
+        import skgesture._descriptor._compute as compute
+        status = main(["evaluate", {str(saved)!r}, "synthetic", "--n-sequences",
+                       "2", "--n-classes", "3", "-q"])
+        heavy = [m for m in ("torch", "skorch", "numba") if m in sys.modules]
+        print("status", status, "imported:", heavy,
+              "restored:", compute.USE_COMPILED == compute.USE_COMPILED_DEFAULT)
+        """
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    ).stdout
+    assert "status 0 imported: [] restored: True" in out, out

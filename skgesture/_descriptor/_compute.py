@@ -33,6 +33,7 @@ _ROOT = KINECT_V1.index(KINECT_V1.root)
 # installed; False forces the numpy implementation (tests compare the two).
 # SKGESTURE_DISABLE_NUMBA=1 in the environment sets it to False.
 USE_COMPILED = os.environ.get("SKGESTURE_DISABLE_NUMBA", "0") in ("", "0")
+USE_COMPILED_DEFAULT = USE_COMPILED  # (the command line restores it after a command)
 
 
 def _compiled_kernel():
