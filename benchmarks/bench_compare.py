@@ -25,7 +25,6 @@ Usage::
 """
 
 import argparse
-import ast
 import functools
 import hashlib
 import json
@@ -42,6 +41,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from _common import source_key  # noqa: E402
 from _peers import PEERS, have_seglearn  # noqa: E402
 from bench_methods import (  # noqa: E402
     evaluate,
@@ -227,38 +227,12 @@ def _library_versions():
     return out
 
 
-def _code_only(source):
-    """The source's syntax tree without docstrings: what runs, not its prose.
-
-    Editing a docstring or a comment (citations, wording) leaves the key as it
-    was, so it does not discard hours of cached fits; any change to the code does.
-    """
-    tree = ast.parse(source)
-    for node in ast.walk(tree):
-        body = getattr(node, "body", None)
-        if (
-            isinstance(body, list)
-            and body
-            and isinstance(body[0], ast.Expr)
-            and isinstance(body[0].value, ast.Constant)
-            and isinstance(body[0].value.value, str)
-        ):
-            node.body = body[1:] or [ast.Pass()]
-    return ast.dump(tree, include_attributes=False).encode()
-
-
 @functools.cache
 def _source_bytes(path):
     # Cached: each file is read once, when this process first needs it (primed at
     # import for the registered methods), so that an edit made while a long run
     # goes on cannot label results of the code already loaded.
-    data = Path(path).read_bytes()
-    if str(path).endswith(".py"):
-        try:
-            return _code_only(data.decode("utf-8"))
-        except (SyntaxError, UnicodeDecodeError):
-            pass
-    return data
+    return source_key(path)
 
 
 def code_key(method):

@@ -81,7 +81,6 @@ LOSO x 3 seeds), or ``python benchmarks/run.py --only oov``.
 """
 
 import argparse
-import ast
 import hashlib
 import json
 import os
@@ -96,7 +95,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import format_table, machine_line  # noqa: E402
+from _common import format_table, machine_line, source_key  # noqa: E402
 
 import skgesture  # noqa: E402
 from skgesture._rate import resample  # noqa: E402
@@ -344,30 +343,6 @@ def fit_cell(config, seed, quick, X_tr, y_tr, X_te, negatives, fps):
 # ---------------------------------------------------------------- cache
 
 
-def _code_only(path):
-    """A source file's syntax tree without docstrings (what runs, not its prose).
-
-    Editing a docstring or a comment keeps the cache key, so it does not
-    discard cached fits; any change to the code changes it.
-    """
-    data = path.read_bytes()
-    try:
-        tree = ast.parse(data.decode("utf-8"))
-    except (SyntaxError, UnicodeDecodeError):
-        return data
-    for node in ast.walk(tree):
-        body = getattr(node, "body", None)
-        if (
-            isinstance(body, list)
-            and body
-            and isinstance(body[0], ast.Expr)
-            and isinstance(body[0].value, ast.Constant)
-            and isinstance(body[0].value.value, str)
-        ):
-            node.body = body[1:] or [ast.Pass()]
-    return ast.dump(tree, include_attributes=False).encode()
-
-
 def _code_key(data_sizes):
     """Hash of the skgesture and benchmark code, versions and data sizes."""
     import sklearn
@@ -377,7 +352,7 @@ def _code_key(data_sizes):
     pkg = Path(skgesture.__file__).resolve().parent
     for path in sorted(pkg.rglob("*.py")) + [Path(__file__).resolve()]:
         h.update(str(path.relative_to(ROOT)).encode())
-        h.update(_code_only(path))
+        h.update(source_key(path))
     versions = [platform.python_version(), np.__version__, sklearn.__version__]
     h.update(json.dumps(versions + [torch.__version__, data_sizes]).encode())
     return h.hexdigest()[:12]
