@@ -8,6 +8,13 @@ from contextlib import contextmanager
 from pathlib import Path
 
 
+def shared_data_dir():
+    """The real data folder: ``$SKGESTURE_SHARED_DATA`` or ``<repo>/../shared/data``."""
+    env = os.environ.get("SKGESTURE_SHARED_DATA")
+    root = Path(__file__).resolve().parents[1]
+    return Path(env) if env else root.parent / "shared" / "data"
+
+
 def median_time(func, repeat=5, warmup=1):
     """Median wall time of ``func()`` over ``repeat`` runs, after ``warmup`` runs."""
     for _ in range(warmup):

@@ -6,8 +6,17 @@ and the four peers of ``_peers.py`` (GRU, HGB, seglearn, MiniRocket), on
 
 * PRECOG, leave one subject out over the 8 bundled subjects, with the 20 joints
   and with the paper's 11 (``joints="full20"`` / ``"paper11"``);
+* UTKinect (the 20 streams of ``../shared/data/utkinect_action3d``: 10 daily
+  actions, continuous, 10 subjects), leave one subject out, 20 joints. Its rows
+  are irregular (5-10 a second); every model sees rows as frames, as the peers do;
 * the synthetic streams of ``bench_methods.py`` (100 training, 50 test streams of
   10 unseen subjects, the paper's 11 joints).
+
+``format_tables`` prints the table and, under it, the **margins**: for each
+dataset, each skgesture model's Jaccard minus the best peer's (the peers being
+the rows of family ``peer`` measured on that dataset), and the worst case over
+the datasets, the number by which the recommended model is chosen
+(docs/choosing.md).
 
 Every (dataset, joints, method, seed, fold) result is a JSON file under
 ``bench_results/compare/``, keyed by the method's parameters, the code it runs
@@ -20,7 +29,7 @@ with a second worker). The table is the mean over seeds of the mean over folds;
 Usage::
 
     python benchmarks/bench_compare.py [--quick] [--methods M,...]
-        [--datasets precog,synthetic] [--joints full20,paper11] [--seeds 0,1,2]
+        [--datasets precog,utkinect,synthetic] [--joints full20,paper11] [--seeds 0,1,2]
         [--no-compute] [--cache-dir DIR] [--list]
 """
 
@@ -33,6 +42,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,7 +51,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import source_key  # noqa: E402
+from _common import format_table, shared_data_dir, source_key  # noqa: E402
 from _peers import PEERS, have_seglearn  # noqa: E402
 from bench_methods import (  # noqa: E402
     evaluate,
@@ -56,7 +66,11 @@ import skgesture  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 CACHE_DIR = ROOT / "bench_results" / "compare"
 SEEDS = (0, 1, 2)
-DATASETS = {"precog": ("full20", "paper11"), "synthetic": ("paper11",)}
+DATASETS = {
+    "precog": ("full20", "paper11"),
+    "utkinect": ("full20",),
+    "synthetic": ("paper11",),
+}
 COLUMNS = [
     "data",
     "joints",
@@ -300,7 +314,8 @@ class Folds:
 
 
 def load_folds(dataset, quick):
-    """The folds of ``dataset`` ("precog" or "synthetic")."""
+    """The folds of ``dataset`` ("precog", "utkinect" or "synthetic"), or None
+    when its recordings are not on this machine."""
     if dataset == "precog":
         from skgesture.datasets import load_precog
 
@@ -310,13 +325,31 @@ def load_folds(dataset, quick):
             (f"subject{groups[te][0]}", tr, te) for tr, te in precog_folds(data, quick)
         ]
         label = f"PRECOG LOSO ({len(folds)} folds)"
+    elif dataset == "utkinect":
+        from skgesture.datasets import DataFileWarning, load_utkinect
+
+        path = shared_data_dir() / "utkinect_action3d"
+        if not path.is_dir():
+            return None
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DataFileWarning)  # overlapping labels
+            data = load_utkinect(path)
+        groups = np.asarray(data.groups)
+        subjects = np.unique(groups)[: 2 if quick else None]
+        folds = [
+            (f"subject{g}", np.flatnonzero(groups != g), np.flatnonzero(groups == g))
+            for g in subjects
+        ]
+        label = f"UTKinect LOSO ({len(folds)} folds)"
     elif dataset == "synthetic":
         data, tr, te = synthetic_split(quick)
         folds = [("unseen", tr, te)]
         label = f"synthetic {len(tr)}/{len(te)}"
         dataset = f"synthetic{len(tr)}_{len(te)}"
     else:
-        raise ValueError(f"unknown dataset {dataset!r}; use precog or synthetic")
+        raise ValueError(
+            f"unknown dataset {dataset!r}; use precog, utkinect or synthetic"
+        )
     return Folds(dataset, label, data, folds, data_key(data.X, data.y))
 
 
@@ -418,7 +451,7 @@ def summarise(label, joints, name, cells, seeds, fold_ids):
 def run(
     quick=False,
     methods=DEFAULT_METHODS,
-    datasets=("precog", "synthetic"),
+    datasets=("precog", "utkinect", "synthetic"),
     joints=("full20", "paper11"),
     seeds=None,
     compute=True,
@@ -446,6 +479,11 @@ def run(
     with tempfile.TemporaryDirectory() as memory_dir:
         for dataset in datasets:
             folds = load_folds(dataset, quick)
+            if folds is None:
+                NOTES.append(
+                    f"{dataset}: recordings not found under {shared_data_dir()}"
+                )
+                continue
             fold_ids = [f[0] for f in folds.folds]
             for js in DATASETS[dataset]:
                 if js not in joints:
@@ -470,19 +508,71 @@ def run(
                                 cells[(seed, fold[0])] = row
                     summary = summarise(folds.label, js, name, cells, seeds, fold_ids)
                     if summary is not None:
+                        summary["family"] = method.family
                         table.append(summary)
                     elif not compute:
                         NOTES.append(f"{folds.label} {js} {name}: nothing cached")
     return table
 
 
+def margins(rows):
+    """The margin table: each skgesture model's Jaccard minus the best peer's, per
+    dataset, and the worst case over the datasets where both were measured.
+
+    Returns ``(columns, rows)``; a dataset without a peer row has no margin.
+    """
+    datasets = []
+    for r in rows:
+        key = f"{r['data']}, {r['joints']}"
+        if key not in datasets:
+            datasets.append(key)
+    best = {}
+    for r in rows:
+        if r.get("family") == "peer":
+            key = f"{r['data']}, {r['joints']}"
+            if r["jaccard"] > best.get(key, ("", -1.0))[1]:
+                best[key] = (r["method"], r["jaccard"])
+    out = []
+    for name in dict.fromkeys(r["method"] for r in rows if r.get("family") != "peer"):
+        row = {"method": name}
+        for r in rows:
+            key = f"{r['data']}, {r['joints']}"
+            if r["method"] == name and key in best:
+                row[key] = r["jaccard"] - best[key][1]
+        have = [v for k, v in row.items() if k != "method"]
+        row["worst case"] = min(have) if have else ""
+        row["datasets"] = f"{len(have)}/{len(best)}"
+        out.append(row)
+    out.sort(key=lambda r: -r["worst case"] if r["worst case"] != "" else 1.0)
+    peers = [{"method": "best peer"}]
+    for key, (name, jac) in best.items():
+        peers[0][key] = f"{name} {jac:.3f}"
+    columns = (
+        ["method"] + [k for k in datasets if k in best] + ["worst case", "datasets"]
+    )
+    return columns, peers + out
+
+
+def format_tables(rows, title):
+    """The table, then the margins over the best peer with their worst case."""
+    text = format_table(rows, COLUMNS, title)
+    columns, margin_rows = margins(rows)
+    if len(margin_rows) > 1:
+        text += "\n" + format_table(
+            margin_rows,
+            columns,
+            "Margin over the best peer (Jaccard difference); worst case over datasets",
+        )
+    return text
+
+
 def main(argv=None):
-    from _common import format_table, machine_line
+    from _common import machine_line
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="2 folds, 1 seed")
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS))
-    parser.add_argument("--datasets", default="precog,synthetic")
+    parser.add_argument("--datasets", default="precog,utkinect,synthetic")
     parser.add_argument("--joints", default="full20,paper11")
     parser.add_argument(
         "--seeds", default=None, help="comma-separated seeds (default 0,1,2)"
@@ -516,7 +606,7 @@ def main(argv=None):
         compute=not args.no_compute,
     )
     print(machine_line() + "\n")
-    print(format_table(rows, COLUMNS, "skgesture beside the peers"))
+    print(format_tables(rows, "skgesture beside the peers"))
     for note in NOTES:
         print(f"* {note}")
 

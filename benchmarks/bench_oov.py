@@ -95,7 +95,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import format_table, machine_line, source_key  # noqa: E402
+from _common import format_table, machine_line, shared_data_dir, source_key  # noqa: E402
 
 import skgesture  # noqa: E402
 from skgesture._rate import resample  # noqa: E402
@@ -173,12 +173,6 @@ class Negatives:
     def minutes(self):
         """Duration in minutes: the rows of every stream over its frame rate."""
         return float(sum(len(x) / f for x, f in zip(self.X, self.fps)) / 60.0)
-
-
-def shared_data_dir():
-    """The real data folder: ``$SKGESTURE_SHARED_DATA`` or ``<repo>/../shared/data``."""
-    env = os.environ.get("SKGESTURE_SHARED_DATA")
-    return Path(env) if env else ROOT.parent / "shared" / "data"
 
 
 def _class_ids(target_names, names):
