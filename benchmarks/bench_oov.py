@@ -95,7 +95,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import format_table, machine_line, shared_data_dir, source_key  # noqa: E402
+from _common import (  # noqa: E402
+    format_table,
+    machine_line,
+    shared_data_dir,
+    source_key,
+)
 
 import skgesture  # noqa: E402
 from skgesture._rate import resample  # noqa: E402
@@ -108,7 +113,11 @@ from skgesture.datasets import (  # noqa: E402
     make_background,
     make_gesture_streams,
 )
-from skgesture.metrics import jaccard_index, segments_to_labels  # noqa: E402
+from skgesture.metrics import (  # noqa: E402
+    jaccard_index,
+    rejection_curve,
+    segments_to_labels,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench_results"
@@ -361,58 +370,29 @@ def _cell_path(cache_dir, config, fold, seed, key):
 # ---------------------------------------------------------------- scoring
 
 
-def best_match_confidence(true_segments, pred):
-    """Per true gesture, the highest confidence of a matching predicted segment.
-
-    A prediction matches when it has the same class and IoU >= ``MIN_IOU``;
-    ``-inf`` when none does. The gesture is found at threshold ``t`` when this
-    is >= ``t``.
-    """
-    out = []
-    for c, s, e in true_segments:
-        best = -np.inf
-        for pc, ps, pe, conf in pred:
-            if int(pc) != int(c):
-                continue
-            inter = min(e, pe) - max(s, ps)
-            if inter <= 0:
-                continue
-            iou = inter / ((e - s) + (pe - ps) - inter)
-            if iou >= MIN_IOU:
-                best = max(best, conf)
-        out.append(best)
-    return np.asarray(out, dtype=float)
-
-
 def score_cell(cell, y_te, true_segments, thresholds):
     """Recall, Jaccard and events per minute of one fit at every threshold.
 
+    Recall is ``skgesture.metrics.rejection_curve``'s (same class, IoU >=
+    ``MIN_IOU``) over the true gestures of at least ``MIN_TRUE_LENGTH`` frames.
     Returns ``{threshold: {"recall", "jaccard", "gestures", "events": {name:
     count}}}``.
     """
     pred = [np.asarray(p, dtype=float).reshape(-1, 4) for p in cell["positives"]]
-    best = np.concatenate(
-        [
-            best_match_confidence(
-                [
-                    r
-                    for r in np.asarray(t).reshape(-1, 3)
-                    if r[2] - r[1] >= MIN_TRUE_LENGTH
-                ],
-                p,
-            )
-            for t, p in zip(true_segments, pred)
-        ]
-    )
+    true = [
+        [r for r in np.asarray(t).reshape(-1, 3) if r[2] - r[1] >= MIN_TRUE_LENGTH]
+        for t in true_segments
+    ]
+    curve = rejection_curve(true, pred, thresholds=thresholds, min_iou=MIN_IOU)
     out = {}
-    for t in thresholds:
+    for t, recall in zip(thresholds, curve.recall):
         labels = [
             segments_to_labels(p[p[:, 3] >= t, :3].astype(np.int64), len(y))
             for p, y in zip(pred, y_te)
         ]
         out[t] = {
-            "recall": float(np.mean(best >= t)) if best.size else float("nan"),
-            "gestures": int(best.size),
+            "recall": float(recall),
+            "gestures": curve.n_gestures,
             "jaccard": float(jaccard_index(y_te, labels)),
             "events": {
                 name: int(np.sum(np.asarray(conf) >= t))

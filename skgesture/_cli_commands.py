@@ -46,6 +46,7 @@ from skgesture._cli_support import (
     _target_names,
     _training_rate,
     _warn_unknown_rate,
+    fast_tradeoff,
 )
 
 __all__ = [
@@ -90,6 +91,8 @@ def cmd_train(args):
             else ""
         ),
     )
+    if args.fast:
+        _info(args, fast_tradeoff(args.method))
     start = time.perf_counter()
     X = list(data.X) + X_bg
     y = list(data.y) + [np.zeros(len(x), dtype=int) for x in X_bg]

@@ -30,6 +30,14 @@ FAST_MAX_EPOCHS = 60
 # --fast recommended model: a one-stage TCN on fewer, smaller batches (about
 # 30 times less work per epoch than the default's 3 stages of 8 layers).
 FAST_TCN = {"tcn_stages": 1, "tcn_layers": 6, "steps_per_epoch": 5, "batch_size": 8}
+# What --fast gives up, said before such a training (docs/cli.md has the measured cost).
+FAST_TRADEOFF = {
+    "recommended": "a one-stage, 6-layer temporal network instead of 3 stages of 8, "
+    "trained on 300 batches of 8 crops instead of 600 of 16",
+    "A": "networks of one 32-unit layer instead of the paper's sizes, 60 epochs",
+    "B": "networks of one 32-unit layer instead of the paper's sizes, 60 epochs",
+    "C": "a one-layer, 16-unit recurrent network, 60 epochs",
+}
 PROGRESS_LINE_SECONDS = 10.0  # a bar's state at most this often, stderr no terminal
 # What tqdm writes to redraw its bars: a carriage return before each state, and
 # newlines and "cursor up" around the states of nested bars.
@@ -45,6 +53,15 @@ class UsageError(Exception):
 
 
 # -- output ----------------------------------------------------------------------
+
+
+def fast_tradeoff(method):
+    """The line ``train --fast`` prints: what the quick model gives up."""
+    what = FAST_TRADEOFF.get(method, FAST_TRADEOFF["C"])
+    return (
+        f"--fast: {what}; a quick trial of the pipeline, not a model to deploy "
+        "(expect a clearly lower Jaccard; docs/cli.md)"
+    )
 
 
 def _info(args, message):

@@ -100,20 +100,3 @@ def test_figure_and_tables(quick_run):
     for t in ("0.00", "0.60", "0.90"):
         assert f"| {t} |" in text
     assert any("protocol (quick)" in note for note in bench_oov.NOTES)
-
-
-def test_best_match_confidence_rule():
-    # IoU >= 0.5 with a segment of the same class; the best such confidence
-    true = [(1, 0, 10), (2, 20, 30), (1, 40, 50)]
-    pred = np.array(
-        [
-            [1, 0, 8, 0.7],  # IoU 0.8: match
-            [1, 2, 12, 0.9],  # IoU 8/12: match, higher confidence
-            [1, 20, 30, 0.99],  # wrong class
-            [2, 27, 40, 0.8],  # IoU 3/20: too little
-            [1, 45, 60, 0.6],  # IoU 5/20: too little
-        ]
-    )
-    best = bench_oov.best_match_confidence(true, pred)
-    assert best[0] == pytest.approx(0.9)
-    assert np.isneginf(best[1]) and np.isneginf(best[2])

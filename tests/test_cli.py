@@ -226,6 +226,9 @@ def test_progress_bars_are_plain_lines_in_a_log(tmp_path):
     assert "\r" not in err and "\x1b" not in err, repr(err)
     assert re.search(r"epoch", err), err  # the networks' bars, as lines
     assert "training method B" in err
+    # --fast says what the quick model gives up, before it trains
+    assert "--fast: networks of one 32-unit layer" in err, err
+    assert err.index("--fast:") < err.index("epoch"), err
 
 
 def test_progress_lines_of_nested_bars():

@@ -4,11 +4,13 @@ The ChaLearn LAP 2014 Jaccard index exactly as the official script computes it
 (with the penalised and inclusive variants of docs/method.md §2.3), frame accuracy,
 the frame confusion matrix, the per-class report (frame precision, recall and F1,
 gestures found), the segmental F1@k and edit scores of temporal action
-segmentation, and scorers for ``GridSearchCV``.
+segmentation, the event-level recall and false events per minute of a command
+interface (``rejection_curve``), and scorers for ``GridSearchCV``.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from skgesture.metrics._events import event_recall, rejection_curve
 from skgesture.metrics._jaccard import jaccard_index, jaccard_index_segments
 from skgesture.metrics._scorers import (
     SCORERS,
@@ -34,6 +36,8 @@ __all__ = [
     "per_class_report",
     "segmental_f1",
     "edit_score",
+    "event_recall",
+    "rejection_curve",
     "jaccard_scorer",
     "make_jaccard_scorer",
     "make_sequence_scorer",
