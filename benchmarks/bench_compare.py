@@ -557,7 +557,7 @@ def format_tables(rows, title):
     """The table, then the margins over the best peer with their worst case."""
     text = format_table(rows, COLUMNS, title)
     columns, margin_rows = margins(rows)
-    if len(margin_rows) > 1:
+    if len(columns) > 3 and len(margin_rows) > 1:  # a peer and a model measured
         text += "\n" + format_table(
             margin_rows,
             columns,
