@@ -126,10 +126,26 @@ def _make_recommended(joints, seed, memory_dir):
     return skgesture.make_recommended(joints=joints, random_state=seed)
 
 
-def _make_recommended_descriptor(joints, seed, memory_dir):
-    return skgesture.make_recommended(
-        joints=joints, features="descriptor", random_state=seed
-    )
+def _variant(**params):
+    """A ``make`` of ``make_recommended(**params)``: the candidates of the default."""
+
+    def make(joints, seed, memory_dir):
+        return skgesture.make_recommended(joints=joints, random_state=seed, **params)
+
+    return make
+
+
+# The other candidates for make_recommended's default (docs/choosing.md): the
+# whole-sequence models (best offline, approximate live) and the exact model on
+# joint features.
+VARIANTS = {
+    "recommended (joints whole)": {"features": "joints", "lookahead": None},
+    "recommended (descriptor whole)": {
+        "features": "descriptor",
+        "lookahead": None,
+    },
+    "recommended (joints exact 8)": {"features": "joints", "lookahead": 8},
+}
 
 
 def _recommended_unavailable():
@@ -156,11 +172,12 @@ REGISTRY["recommended"] = Method(
     unavailable=_recommended_unavailable,
     sources=_skg_sources(),
 )
-REGISTRY["recommended (descriptor)"] = Method(
-    make=_make_recommended_descriptor,
-    unavailable=_recommended_unavailable,
-    sources=_skg_sources(),
-)
+for _name, _params in VARIANTS.items():
+    REGISTRY[_name] = Method(
+        make=_variant(**_params),
+        unavailable=_recommended_unavailable,
+        sources=_skg_sources(),
+    )
 REGISTRY["B (tuned)"] = _skgesture_method("B (tuned)")
 for _name, (_cls, _why) in PEERS.items():
     REGISTRY[_name] = _peer_method(_cls, _why)
@@ -171,7 +188,8 @@ DEFAULT_METHODS = (
     "B",
     "C (cpu)",
     "recommended",
-    "recommended (descriptor)",
+    "recommended (joints whole)",
+    "recommended (descriptor whole)",
     "GRU peer",
     "HGB peer",
     "seglearn peer",
@@ -180,7 +198,13 @@ DEFAULT_METHODS = (
 
 
 def register(name, make, *, family="skgesture", unavailable=None, sources=None):
-    """Add (or replace) a row: ``make(joints, seed, memory_dir)`` -> estimator."""
+    """Add (or replace) a row: ``make(joints, seed, memory_dir)`` -> estimator.
+
+    ``name`` has no comma (``--methods`` is a comma-separated list)."""
+    if "," in name:
+        raise ValueError(
+            f"a method name has no comma (--methods splits on it): {name!r}"
+        )
     REGISTRY[name] = Method(
         make=make,
         family=family,

@@ -158,6 +158,20 @@ def test_streamed_events_are_the_offline_segments(exact_model):
     assert found > 0
 
 
+def test_sequences_of_other_lengths_batched_together_keep_their_probabilities(
+    exact_model,
+):
+    # a causal network runs sequences of different lengths as one padded batch;
+    # each one's probabilities are those of its own run
+    pipe, X = exact_model
+    F = pipe[:-1].transform([X[0], X[1][:-37], X[1][:120]])
+    assert len({len(f) for f in F}) == 3
+    together = pipe[-1].predict_proba(F)
+    for f, p in zip(F, together):
+        assert p.shape == (len(f), 3 + 1)
+        assert_allclose(pipe[-1].predict_proba([f])[0], p, atol=1e-6)
+
+
 def test_the_delay_is_the_lookahead_and_the_decoding(exact_model):
     pipe, X = exact_model
     tagger = pipe[-1]
@@ -181,14 +195,18 @@ def test_mask_dropout_is_dropout():
     assert torch.equal(MaskDropout(0.0).train()(x), x)
 
 
-def test_make_recommended_with_a_lookahead_streams_exactly():
+@pytest.mark.parametrize("features", ["descriptor", "joints"])
+def test_make_recommended_with_a_lookahead_streams_exactly(features):
     from skgesture import make_recommended
 
     data = make_gesture_streams(
         n_sequences=5, n_classes=3, n_gestures=(3, 4), random_state=1
     )
-    model = make_recommended(joints="full20", lookahead=4, random_state=0)
-    assert model.named_steps["features"].statistics == "running"
+    model = make_recommended(
+        joints="full20", features=features, lookahead=4, random_state=0
+    )
+    if features == "joints":
+        assert model.named_steps["features"].statistics == "running"
     model.set_params(
         tagger__hidden_sizes=(8,), tagger__tcn_layers=4, tagger__tcn_stages=2,
         tagger__max_epochs=3, tagger__steps_per_epoch=5, tagger__crop_length=64,

@@ -217,6 +217,11 @@ def test_new_files_record_public_names(fitted, tmp_path):
         "rec": skgesture.make_recommended(random_state=0).set_params(
             tagger__hidden_sizes=(4,), tagger__max_epochs=1, tagger__steps_per_epoch=2
         ),
+        "rec_joints": skgesture.make_recommended(
+            features="joints", random_state=0
+        ).set_params(
+            tagger__hidden_sizes=(4,), tagger__max_epochs=1, tagger__steps_per_epoch=2
+        ),
     }
     if fitted:  # the taggers only: Method B's unfitted file has its classes
         del models["b"]

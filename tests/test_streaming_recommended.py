@@ -54,7 +54,8 @@ def _tagger(architecture="gru", **params):
 
 def _fit(tagger, precog):
     X, y = _split(precog, (1,))
-    model = make_recommended(random_state=0)
+    # the whole-sequence model on joint features, streamed over a trailing window
+    model = make_recommended(features="joints", lookahead=None, random_state=0)
     model.steps[-1] = ("tagger", tagger)
     return model.fit(X[:4], y[:4])
 

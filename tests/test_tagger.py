@@ -456,11 +456,22 @@ def _tiny_tagger_params():
 
 @pytest.mark.parametrize("joints, width", [("paper11", 66), ("full20", 120)])
 def test_make_recommended_builds_the_documented_pipeline(joints, width):
-    model = make_recommended(joints=joints, random_state=0)
+    model = make_recommended(joints=joints, features="joints", random_state=0)
     X, y = make_skeleton_stream(random_state=0)
     features = model.steps[0][1].fit([X])
     assert features.n_features_out_ == width
     assert model.steps[0][1].joints == joints
+
+
+def test_make_recommended_default_streams_exactly_on_the_descriptor():
+    # the default is chosen by its worst case among exactly streaming models
+    model = make_recommended(joints="paper11", random_state=0)
+    assert type(model.steps[0][1]).__name__ == "PoseDescriptor"
+    assert model.steps[-1][1].lookahead == 8
+    offline = make_recommended(features="joints", lookahead=None)
+    assert offline.steps[-1][1].lookahead is None
+    assert offline.steps[0][1].statistics == "sequence"
+    assert make_recommended(features="joints").steps[0][1].statistics == "running"
 
 
 def test_make_recommended_descriptor_variant_reads_the_paper_descriptor():

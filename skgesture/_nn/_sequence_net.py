@@ -316,18 +316,51 @@ class _CropNet(FramewiseNetwork):
         return self
 
 
+PAD_BATCH = 32  # sequences per padded batch of a causal network
+PAD_WASTE = 1.5  # a padded batch's longest sequence is at most this times its shortest
+
+
+def _batches(lengths, causal):
+    """Index groups run as one batch: sequences of equal length, or for a causal
+    network (whose outputs do not depend on later frames, so zero rows after a
+    sequence change nothing of it) runs of similar lengths, padded."""
+    if not causal:
+        groups = {}
+        for i, n in enumerate(lengths):
+            groups.setdefault(n, []).append(i)
+        return list(groups.values())
+    order = sorted(range(len(lengths)), key=lambda i: lengths[i])
+    out, current = [], []
+    for i in order:
+        if current and (
+            len(current) == PAD_BATCH
+            or lengths[i] > PAD_WASTE * max(lengths[current[0]], 1)
+        ):
+            out.append(current)
+            current = []
+        current.append(i)
+    return out + [current] if current else out
+
+
 def predict_whole(module, X, mean, scale, n_classes):
     """Per-frame softmax probabilities of ``module`` run over whole sequences.
 
-    Sequences of equal length are batched together; the output is float64.
+    Sequences of equal length are batched together; for a TCN with a bounded
+    look-ahead (causal), sequences of similar lengths too, zero-padded at the
+    end: a causal network's output for a frame depends on no later frame, and
+    the padding is the zeros the network appends itself, so each sequence's
+    probabilities are those of its own run (to float32 rounding). The output
+    is float64.
     """
     module.eval()
     out = [None] * len(X)
-    by_length = {}
-    for i, x in enumerate(X):
-        by_length.setdefault(len(x), []).append(i)
-    for idx in by_length.values():
-        xb = np.stack([(X[i] - mean) / scale for i in idx]).astype(np.float32)
+    causal = getattr(module, "lookahead", None) is not None
+    lengths = [len(x) for x in X]
+    for idx in _batches(lengths, causal):
+        T = max(lengths[i] for i in idx)
+        xb = np.zeros((len(idx), T, np.shape(X[idx[0]])[1]), dtype=np.float32)
+        for row, i in enumerate(idx):
+            xb[row, : lengths[i]] = (X[i] - mean) / scale
         for i, p in zip(idx, frame_probabilities(module, xb)):
-            out[i] = p.reshape(len(X[i]), n_classes)
+            out[i] = p[: lengths[i]].reshape(lengths[i], n_classes)
     return out
