@@ -15,6 +15,18 @@ def shared_data_dir():
     return Path(env) if env else root.parent / "shared" / "data"
 
 
+def load_utkinect_quiet(path):
+    """``skgesture.datasets.load_utkinect(path)`` without its warnings about the
+    overlapping labels of the original annotation file (the benchmarks know)."""
+    import warnings
+
+    from skgesture.datasets import DataFileWarning, load_utkinect
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataFileWarning)
+        return load_utkinect(path)
+
+
 def median_time(func, repeat=5, warmup=1):
     """Median wall time of ``func()`` over ``repeat`` runs, after ``warmup`` runs."""
     for _ in range(warmup):

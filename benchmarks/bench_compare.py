@@ -42,7 +42,6 @@ import subprocess
 import sys
 import tempfile
 import time
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,7 +50,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import format_table, shared_data_dir, source_key  # noqa: E402
+from _common import (  # noqa: E402
+    format_table,
+    load_utkinect_quiet,
+    shared_data_dir,
+    source_key,
+)
 from _peers import PEERS, have_seglearn  # noqa: E402
 from bench_methods import (  # noqa: E402
     evaluate,
@@ -122,10 +126,6 @@ def _skgesture_method(name):
     return Method(make=make, family="skgesture", sources=_skg_sources())
 
 
-def _make_recommended(joints, seed, memory_dir):
-    return skgesture.make_recommended(joints=joints, random_state=seed)
-
-
 def _variant(**params):
     """A ``make`` of ``make_recommended(**params)``: the candidates of the default."""
 
@@ -135,10 +135,11 @@ def _variant(**params):
     return make
 
 
-# The other candidates for make_recommended's default (docs/choosing.md): the
-# whole-sequence models (best offline, approximate live) and the exact model on
-# joint features.
+# make_recommended's default and the other candidates for it (docs/choosing.md):
+# the whole-sequence models (best offline, approximate live) and the exact model
+# on joint features.
 VARIANTS = {
+    "recommended": {},
     "recommended (joints whole)": {"features": "joints", "lookahead": None},
     "recommended (descriptor whole)": {
         "features": "descriptor",
@@ -167,11 +168,6 @@ def _peer_method(cls, unavailable):
 
 
 REGISTRY = {name: _skgesture_method(name) for name in ("forest", "A", "B", "C (cpu)")}
-REGISTRY["recommended"] = Method(
-    make=_make_recommended,
-    unavailable=_recommended_unavailable,
-    sources=_skg_sources(),
-)
 for _name, _params in VARIANTS.items():
     REGISTRY[_name] = Method(
         make=_variant(**_params),
@@ -340,31 +336,21 @@ class Folds:
 def load_folds(dataset, quick):
     """The folds of ``dataset`` ("precog", "utkinect" or "synthetic"), or None
     when its recordings are not on this machine."""
-    if dataset == "precog":
-        from skgesture.datasets import load_precog
+    if dataset in ("precog", "utkinect"):
+        if dataset == "precog":
+            from skgesture.datasets import load_precog
 
-        data = load_precog()
+            data, name = load_precog(), "PRECOG"
+        else:
+            path = shared_data_dir() / "utkinect_action3d"
+            if not path.is_dir():
+                return None
+            data, name = load_utkinect_quiet(path), "UTKinect"
         groups = np.asarray(data.groups)
-        folds = [
+        folds = [  # leave one subject out, in subject order (2 folds when quick)
             (f"subject{groups[te][0]}", tr, te) for tr, te in precog_folds(data, quick)
         ]
-        label = f"PRECOG LOSO ({len(folds)} folds)"
-    elif dataset == "utkinect":
-        from skgesture.datasets import DataFileWarning, load_utkinect
-
-        path = shared_data_dir() / "utkinect_action3d"
-        if not path.is_dir():
-            return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DataFileWarning)  # overlapping labels
-            data = load_utkinect(path)
-        groups = np.asarray(data.groups)
-        subjects = np.unique(groups)[: 2 if quick else None]
-        folds = [
-            (f"subject{g}", np.flatnonzero(groups != g), np.flatnonzero(groups == g))
-            for g in subjects
-        ]
-        label = f"UTKinect LOSO ({len(folds)} folds)"
+        label = f"{name} LOSO ({len(folds)} folds)"
     elif dataset == "synthetic":
         data, tr, te = synthetic_split(quick)
         folds = [("unseen", tr, te)]

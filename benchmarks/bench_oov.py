@@ -87,7 +87,6 @@ import os
 import platform
 import sys
 import time
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -97,6 +96,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import (  # noqa: E402
     format_table,
+    load_utkinect_quiet,
     machine_line,
     shared_data_dir,
     source_key,
@@ -105,11 +105,9 @@ from _common import (  # noqa: E402
 import skgesture  # noqa: E402
 from skgesture._rate import resample  # noqa: E402
 from skgesture.datasets import (  # noqa: E402
-    DataFileWarning,
     load_msr_action3d,
     load_msrc12,
     load_precog,
-    load_utkinect,
     make_background,
     make_gesture_streams,
 )
@@ -217,9 +215,7 @@ def _load_msrc(path):
 
 
 def _load_utk(path):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DataFileWarning)  # overlapping labels
-        data = load_utkinect(path)
+    data = load_utkinect_quiet(path)
     fps = np.asarray(data.fps, dtype=float)
     how = f"{len(data.X)} streams at {fps.min():.1f}-{fps.max():.1f} rows/s"
     return Negatives(UTK, list(data.X), fps, how)
