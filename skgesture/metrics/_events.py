@@ -50,13 +50,18 @@ def _rows(value, width, what, index):
     return arr
 
 
-def _check_lists(true_segments, events):
-    if isinstance(true_segments, np.ndarray) or isinstance(events, np.ndarray):
+def _per_sequence(value, name):
+    """``value`` as a list of one array per sequence; one array is refused."""
+    if isinstance(value, np.ndarray):
         raise TypeError(
-            "true_segments and events must be lists (one array per sequence), "
-            "not one array"
+            f"{name} must be lists of rows (one array per sequence), not one array"
         )
-    true_segments, events = list(true_segments), list(events)
+    return list(value)
+
+
+def _check_lists(true_segments, events):
+    true_segments = _per_sequence(true_segments, "true_segments")
+    events = _per_sequence(events, "events")
     if len(true_segments) != len(events):
         raise ValueError(
             f"true_segments has {len(true_segments)} sequences, events "
@@ -119,7 +124,6 @@ def event_recall(true_segments, events, *, min_confidence=0.0, min_iou=0.5):
     >>> event_recall(true, events)
     0.5
     """
-    _check_threshold_like(min_iou, "min_iou")
     curve = rejection_curve(
         true_segments, events, thresholds=[min_confidence], min_iou=min_iou
     )
@@ -197,8 +201,7 @@ def rejection_curve(
         if background_minutes is not None:
             raise ValueError("background_minutes is given without background_events")
         return out
-    if isinstance(background_events, np.ndarray):
-        raise TypeError("background_events must be a list (one array per sequence)")
+    background_events = _per_sequence(background_events, "background_events")
     if not isinstance(background_minutes, numbers.Real) or not (
         background_minutes > 0 and np.isfinite(background_minutes)
     ):
