@@ -60,7 +60,7 @@ def fast_tradeoff(method):
     what = FAST_TRADEOFF.get(method, FAST_TRADEOFF["C"])
     return (
         f"--fast: {what}; a quick trial of the pipeline, not a model to deploy "
-        "(expect a clearly lower Jaccard; docs/cli.md)"
+        "(expect a lower Jaccard; docs/cli.md)"
     )
 
 
