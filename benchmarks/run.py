@@ -27,6 +27,10 @@ SECTIONS = {
     "rate": ("bench_rate", "Frame rates: trained at 30 fps, tested at 15, 10, 20, 60"),
     "startup": ("bench_startup", "Command-line start-up: cold process vs its work"),
     "oov": ("bench_oov", "Out-of-vocabulary rejection: false events/min vs recall"),
+    "decoding": (
+        "bench_decoding",
+        "Decoding defaults by their worst case: Jaccard change, false events/min",
+    ),
     "compare": (
         "bench_compare",
         "skgesture beside the peers (seed means; cached in bench_results/compare)",

@@ -11,6 +11,7 @@ from numbers import Real
 
 import numpy as np
 from sklearn.pipeline import Pipeline
+from sklearn.utils._param_validation import HasMethods
 from sklearn.utils.metadata_routing import UNUSED
 from sklearn.utils.metaestimators import available_if
 from sklearn.utils.validation import check_is_fitted
@@ -81,6 +82,13 @@ class GesturePipeline(Pipeline):
         As for :class:`sklearn.pipeline.Pipeline`.
     verbose : bool, default=False
         As for :class:`sklearn.pipeline.Pipeline`.
+    background : object with ``make(X, y)`` or None, default=None
+        Negatives made in ``fit`` from the training recordings, e.g.
+        :class:`~skgesture.datasets.SyntheticBackground`: its ``make(X, y)``
+        returns sequences (``.X``, all-rest ``.y``) added to the training
+        data, at the training rate. None adds nothing. Made from the data
+        each ``fit`` sees, so a cross-validation fold's negatives come from
+        its own training recordings.
 
     Attributes
     ----------
@@ -132,6 +140,25 @@ class GesturePipeline(Pipeline):
     __metadata_request__decision_function = {"fps": True}
     __metadata_request__score = {"fps": True, "sample_weight": UNUSED}
 
+    _parameter_constraints: dict = {
+        **Pipeline._parameter_constraints,
+        "background": [HasMethods(["make"]), None],
+    }
+
+    def __init__(
+        self,
+        steps,
+        *,
+        transform_input=None,
+        memory=None,
+        verbose=False,
+        background=None,
+    ):
+        super().__init__(
+            steps, transform_input=transform_input, memory=memory, verbose=verbose
+        )
+        self.background = background
+
     def fit(self, X, y=None, fps=None, **params):
         """Fit every step, and record the frame rate of the training data.
 
@@ -171,9 +198,21 @@ class GesturePipeline(Pipeline):
                     f"has one rate; resample the sequences to one rate first "
                     f"(skgesture._rate.resample)"
                 )
+        if self.background is not None:
+            self._validate_params()  # a clear error before make(X, y) is called
+            X, y = self._with_background(X, y)
         super().fit(X, y, **params)
         self.fps_ = float(rate)
         return self
+
+    def _with_background(self, X, y):
+        """The training data with the negatives of ``background`` appended."""
+        if y is None:
+            raise ValueError(
+                "background needs the labels y: negatives are made from the gestures"
+            )
+        made = self.background.make(X, y)
+        return list(X) + list(made.X), list(y) + list(made.y)
 
     def get_metadata_routing(self):
         """Get the metadata routing of this object: the steps' and ``fps``.

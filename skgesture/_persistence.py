@@ -90,6 +90,7 @@ _TRAINING_ONLY = {"callbacks", "train_split"}
 _SUPPORT_CLASSES = (
     ("skgesture.layouts", "DescriptorJoints"),
     ("skgesture.layouts", "SkeletonLayout"),
+    ("skgesture.datasets", "SyntheticBackground"),  # a GesturePipeline's background
 )
 
 

@@ -197,3 +197,72 @@ def test_bad_recordings_are_named():
         make_background([X[0], X[1][:, :2]], y)
     with pytest.raises(TypeError, match="X must be a list of sequences"):
         make_background(X[0], y[0])
+
+
+# -- SyntheticBackground in a GesturePipeline ----------------------------------------
+
+
+class _Recorder:
+    """A last step that keeps what it was fitted on (a stand-in tagger)."""
+
+    def __init__(self):
+        self.seen = None
+
+    def get_params(self, deep=True):
+        return {}
+
+    def set_params(self, **params):
+        return self
+
+    def fit(self, X, y):
+        self.seen = (list(X), list(y))
+        return self
+
+    def predict(self, X):
+        return [np.zeros(len(x), dtype=np.int64) for x in X]
+
+
+def _pipeline(background):
+    from skgesture import GesturePipeline
+
+    return GesturePipeline([("tagger", _Recorder())], background=background)
+
+
+def test_the_pipeline_adds_the_negatives_of_its_training_data(data):
+    from skgesture.datasets import SyntheticBackground
+
+    bg = SyntheticBackground(n_sequences=3, random_state=0)
+    pipe = _pipeline(bg).fit(data.X, data.y, fps=data.fps)
+    X_seen, y_seen = pipe[-1].seen
+    want = make_background(data.X, data.y, n_sequences=3, random_state=0)
+    assert len(X_seen) == len(data.X) + 3
+    for made, seen in zip(want.X, X_seen[len(data.X) :]):
+        assert_array_equal(made, seen)
+    assert all((lab == 0).all() for lab in y_seen[len(data.X) :])
+    # made from the recordings of this fit only: other data, other negatives
+    pipe.fit(data.X[:2], data.y[:2])
+    want = make_background(data.X[:2], data.y[:2], n_sequences=3, random_state=0)
+    assert_array_equal(pipe[-1].seen[0][2], want.X[0])
+
+
+def test_background_none_adds_nothing_and_its_parameters_are_searchable(data):
+    from sklearn.base import clone
+
+    from skgesture.datasets import SyntheticBackground
+
+    pipe = _pipeline(None).fit(data.X, data.y)
+    assert len(pipe[-1].seen[0]) == len(data.X)
+    pipe = _pipeline(SyntheticBackground()).set_params(background__n_sequences=2)
+    assert clone(pipe).background.n_sequences == 2
+    assert len(pipe.fit(data.X, data.y)[-1].seen[0]) == len(data.X) + 2
+
+
+def test_a_background_without_make_or_labels_is_refused(data):
+    from sklearn.utils._param_validation import InvalidParameterError
+
+    from skgesture.datasets import SyntheticBackground
+
+    with pytest.raises(InvalidParameterError, match="'background' parameter"):
+        _pipeline("synthetic").fit(data.X, data.y)
+    with pytest.raises(ValueError, match="needs the labels y"):
+        _pipeline(SyntheticBackground()).fit(data.X)

@@ -235,3 +235,23 @@ def test_same_seed_same_predictions_when_training_on_two_threads():
 
     for a, b in zip(fit(), fit()):
         assert_array_equal(a, b)
+
+
+def test_rejected_runs_stream_exactly(exact_model):
+    # the confidence floor and the per-class duration judge each run on its
+    # own, once it has ended: the live events are still the offline ones
+    import copy
+
+    pipe = copy.deepcopy(exact_model[0])
+    X = exact_model[1]
+    tagger = pipe[-1]
+    F = pipe[:-1].transform(X)
+    before = np.concatenate(tagger.predict_segments(F))
+    tagger.set_params(min_confidence=float(np.median(before[:, 3])), min_duration=0.8)
+    after = tagger.predict_segments(F)
+    assert 0 < sum(len(s) for s in after) < len(before)
+    for x, segments in zip(X, after):
+        events = StreamingRecognizer(pipe).recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))
+        assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)

@@ -165,6 +165,23 @@ def test_round_trip_recommended(data, tmp_path):
         load_model(path, layout="kinect2")
 
 
+def test_round_trip_with_a_synthetic_background(data, tmp_path):
+    # the background object travels with the model (a trusted type), and the
+    # per-class lengths the default decoding reads come back with the tagger
+    pipe = skgesture.make_recommended(background="synthetic", random_state=0)
+    pipe.set_params(
+        tagger__hidden_sizes=(8,), tagger__tcn_layers=2, tagger__tcn_stages=1,
+        tagger__max_epochs=1, tagger__steps_per_epoch=2, tagger__crop_length=32,
+        tagger__fit_threads=1,
+    )  # fmt: skip
+    with torch.random.fork_rng(devices=[]):
+        pipe.fit(data.X, data.y)
+    loaded = load_model(save_model(pipe, tmp_path / "bg.skg"))
+    assert loaded.background.get_params() == pipe.background.get_params()
+    assert_array_equal(loaded[-1].class_lengths_, pipe[-1].class_lengths_)
+    _assert_same_predictions(pipe, loaded, data.X)
+
+
 def test_bare_net_with_tensor_and_array_parameters(tmp_path):
     # A skorch net given directly, with a tensor among its criterion arguments
     # and an array among its attributes: both go to safetensors and come back.
@@ -488,6 +505,7 @@ def test_trusted_types_are_the_public_api_and_what_it_holds():
     }
     assert {TorchMLPClassifier, skgesture.PoseDescriptor} <= public
     support = {layouts.DescriptorJoints, layouts.SkeletonLayout, _NetSlot, _TensorSlot}
+    support.add(skgesture.datasets.SyntheticBackground)  # a pipeline's background
     names = _trusted_type_names()
     resolved = {}
     for name in names:

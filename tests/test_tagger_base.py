@@ -244,3 +244,64 @@ def test_framewise_loss_leaves_out_ignored_frames_and_adds_up_stages():
         logits.reshape(-1, 3)[keep][rest], target.reshape(-1)[keep][rest]
     )
     assert torch.allclose(weighted, ref0)
+
+
+# -- run rules: confidence floor and per-class duration ------------------------------
+
+
+def _bursts(n=4, seed=0):
+    """Streams of :func:`_streams` (a 20-frame gesture) with two 4-frame bursts
+    of the same bump in the rest: brief motion that looks like the gesture,
+    labelled rest."""
+    X, y = _streams(n, seed)
+    for x in X:
+        x[4:8, 0] += 1.5
+        x[48:52, 0] += 1.5
+    return X, y
+
+
+def test_fit_stores_the_short_gesture_of_every_class():
+    X, y = _streams()
+    y[0][20:26] = 2  # one 6-frame run of class 2; class 1 keeps 14-20 frames
+    tagger = TAGGERS["sequence"](random_state=0).fit(X, y)
+    assert_array_equal(tagger.classes_, [0, 1, 2])
+    lengths = tagger.class_lengths_
+    assert lengths[0] == 0 and lengths[2] == 6
+    assert 14 <= lengths[1] <= 20
+
+
+def test_min_duration_removes_brief_runs_and_keeps_the_gestures():
+    tagger = TRAINED["sequence"]().fit(*_streams(3))
+    x_test = _bursts(2, seed=5)[0]
+    plain = tagger.predict(x_test)
+    # the bump is what the network learnt: the bursts are gestures to it
+    assert any(p[4:8].any() for p in plain)
+    tagger.set_params(min_duration=0.5)  # half a short gesture: 7-10 frames
+    kept = tagger.predict(x_test)
+    for p in kept:
+        assert not p[:15].any() and not p[45:].any()
+        assert (p[22:38] == 1).all()
+
+
+def test_min_confidence_drops_the_unsure_runs_only():
+    tagger = TRAINED["sequence"]().fit(*_streams(3))
+    x_test = _streams(2, seed=5)[0]
+    segs = tagger.predict_segments(x_test)
+    conf = np.concatenate([s[:, 3] for s in segs])
+    assert len(conf) >= 2
+    floor = float(np.median(conf))
+    tagger.set_params(min_confidence=floor)
+    kept = np.concatenate(tagger.predict_segments(x_test))
+    assert_array_equal(np.sort(kept[:, 3]), np.sort(conf[conf >= floor]))
+    tagger.set_params(min_confidence=1.0)
+    assert not any(p.any() for p in tagger.predict(x_test))
+
+
+def test_min_duration_on_a_model_fitted_without_lengths_says_so():
+    tagger = TAGGERS["sequence"](random_state=0).fit(*_streams())
+    del tagger.class_lengths_  # a model saved before the attribute existed
+    tagger.set_params(min_duration=0.3)
+    with pytest.raises(ValueError, match="class_lengths_.*refit it"):
+        tagger.predict(_streams(1)[0])
+    tagger.set_params(min_duration=0.0)
+    tagger.predict(_streams(1)[0])

@@ -25,7 +25,12 @@ from sklearn.utils.validation import check_is_fitted
 
 from skgesture._nn._training import IGNORE_INDEX, torch_threads
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
-from skgesture._taggers._decoding import SMOOTHINGS, decode, segments_with_confidence
+from skgesture._taggers._decoding import (
+    SMOOTHINGS,
+    class_lengths,
+    decode,
+    segments_with_confidence,
+)
 from skgesture._taggers._stream import TrailingWindowStream
 from skgesture.utils._fitting import fit_cached, seed_from
 from skgesture.utils._validation import (
@@ -50,6 +55,8 @@ _DECODING_CONSTRAINTS = {
     "smoothing": [StrOptions(SMOOTHINGS)],
     "min_run": [Interval(Integral, 1, None, closed="left")],
     "max_gap": [Interval(Integral, 0, None, closed="left")],
+    "min_confidence": [Interval(Real, 0, 1, closed="both")],
+    "min_duration": [Interval(Real, 0, None, closed="left")],
 }
 
 _STREAM_CONSTRAINTS = {
@@ -65,8 +72,13 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
     ``fit(X, y_idx)`` trains the network; cached by ``memory``),
     ``_adopt(fitted)`` (copies its fitted state) and ``_raw_proba(X)``, and
     have the parameters ``smooth_span``, ``smoothing``, ``min_run``,
-    ``max_gap``, ``memory`` and ``n_threads`` (or class attributes of these
-    names, for rules a tagger fixes).
+    ``max_gap``, ``min_confidence``, ``min_duration``, ``memory`` and
+    ``n_threads`` (or class attributes of these names, for rules a tagger
+    fixes).
+
+    ``fit`` stores ``class_lengths_``, the 10th percentile of every class's
+    training run lengths (its short gesture), so that ``min_duration`` (a
+    fraction of it) changes without retraining.
 
     Untracked rows (those of :func:`untracked_rows`: the masked rows of a
     ``numpy.ma.MaskedArray``, the all-zero rows of a plain array) are rest by
@@ -94,6 +106,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                 "y has no gesture frame (every label is 0): the tagger needs "
                 "labels 1..K as well as rest"
             )
+        self.class_lengths_ = class_lengths(y, classes)
         y_idx = np.split(y_idx.astype(np.int64), np.cumsum([len(v) for v in y])[:-1])
         if ignore_untracked:
             for lab, rows in zip(y_idx, _untracked(X, data)):
@@ -216,15 +229,35 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
         return jaccard_index(y, self.predict(X))
 
+    def _run_rules(self):
+        """The decoding rules on runs, for :func:`decode` and the stream's
+        :class:`~skgesture._taggers._decoding.LabelRuns` alike."""
+        ratio = float(getattr(self, "min_duration", 0.0))
+        lengths = None
+        if ratio > 0:
+            fitted = getattr(self, "class_lengths_", None)
+            if fitted is None:  # a model fitted before min_duration existed
+                raise ValueError(
+                    f"min_duration={ratio} needs class_lengths_, which this "
+                    f"{type(self).__name__} was fitted without: refit it, or set "
+                    "min_duration=0"
+                )
+            lengths = ratio * np.asarray(fitted, dtype=float)
+        return {
+            "min_run": self.min_run,
+            "max_gap": self.max_gap,
+            "min_confidence": float(getattr(self, "min_confidence", 0.0)),
+            "min_lengths": lengths,
+        }
+
     def _decode(self, proba, untracked=None):
         return decode(
             proba,
             self.classes_,
             smooth_span=self.smooth_span,
             smoothing=self.smoothing,
-            min_run=self.min_run,
-            max_gap=self.max_gap,
             untracked=untracked,
+            **self._run_rules(),
         )
 
     def __sklearn_tags__(self):
@@ -275,11 +308,10 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             past,
             self._stream_future(),
             self.smooth_span,
-            self.min_run,
             smoothing=self.smoothing,
-            max_gap=self.max_gap,
             max_run=max_period,
             owner=f"{type(self).__name__}.smooth_span",
+            **self._run_rules(),
         )
 
     @property

@@ -367,6 +367,10 @@ class BiLSTMTagger(_BaseTagger):
     ----------
     classes_ : ndarray of shape (n_classes,)
         Labels seen in ``fit``, rest (0) first.
+    class_lengths_ : ndarray of shape (n_classes,)
+        The 10th percentile of every class's run lengths in ``fit``, in
+        frames (0 for rest); Method C keeps every run of ``min_run`` frames
+        or more, whatever its class's length.
     net_ : skorch.NeuralNet
         The trained network; ``net_.history`` holds the losses and learning
         rates (``"event_lr"``) of every epoch.
@@ -541,6 +545,8 @@ class BiLSTMTagger(_BaseTagger):
     # Decoding rules Method C fixes (read by the shared decoding path).
     smoothing = "loess"  # MATLAB-style loess of span smooth_span
     max_gap = 0  # no merging of split runs
+    min_confidence = 0.0  # and the paper's rules only: no run rejected for
+    min_duration = 0.0  # its confidence or its class's length
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y):

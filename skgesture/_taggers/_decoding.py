@@ -19,7 +19,14 @@ from skgesture.utils._buffers import RowBuffer
 from skgesture.utils._segments import labels_to_segments, remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, MeanStepper, loess_smooth
 
-__all__ = ["decode", "fill_short_gaps", "segments_with_confidence", "smooth_proba"]
+__all__ = [
+    "class_lengths",
+    "decode",
+    "fill_short_gaps",
+    "reject_runs",
+    "segments_with_confidence",
+    "smooth_proba",
+]
 
 SMOOTHINGS = {"loess", "mean", "none"}
 
@@ -99,6 +106,105 @@ def fill_short_gaps(labels, max_gap, *, rest=0):
     return labels
 
 
+LENGTH_QUANTILE = 10  # percentile of a class's training lengths: its "short" gesture
+
+
+def class_lengths(y, classes, *, quantile=LENGTH_QUANTILE):
+    """The length of a short gesture of every class: a percentile of its runs.
+
+    Parameters
+    ----------
+    y : list of ndarray of shape (n_frames_i,)
+        Per-frame training labels (0 = rest; negative labels, the ignored
+        rows, end a run as rest does).
+    classes : ndarray of shape (n_classes,)
+        The classes, rest (0) first.
+    quantile : float, default=10
+        The percentile of every class's run lengths.
+
+    Returns
+    -------
+    ndarray of shape (n_classes,)
+        Frames; 0 for rest and for a class without a run.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import class_lengths
+    >>> y = [np.array([0, 1, 1, 1, 1, 0, 2, 2, 0, 1, 1, 0])]
+    >>> class_lengths(y, np.array([0, 1, 2]), quantile=50).tolist()
+    [0.0, 3.0, 2.0]
+    """
+    classes = np.asarray(classes)
+    lengths = {int(c): [] for c in classes}
+    for labels in y:
+        starts, ends, values = runs(np.asarray(labels))
+        for s, e, v in zip(starts.tolist(), ends.tolist(), values.tolist()):
+            if v > 0 and v in lengths:
+                lengths[v].append(e - s)
+    return np.array(
+        [
+            float(np.percentile(lengths[int(c)], quantile))
+            if c != 0 and lengths[int(c)]
+            else 0.0
+            for c in classes
+        ]
+    )
+
+
+def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
+    """Set to rest the gesture runs too short for their class or too unsure.
+
+    The last rules of the decoding, applied to every run on its own (so a
+    stream decides a run as soon as it ends): a run of class ``c`` shorter
+    than ``min_lengths[c]`` frames, or whose mean raw probability of ``c`` is
+    below ``min_confidence``, becomes rest.
+
+    Parameters
+    ----------
+    labels : ndarray of shape (n_frames,)
+        Decoded labels.
+    raw : ndarray of shape (n_frames, n_classes)
+        Raw (unsmoothed) probabilities, columns in ``classes`` order.
+    classes : ndarray of shape (n_classes,)
+        Labels of the columns.
+    min_confidence : float, default=0.0
+        Lowest mean probability of a run kept (the confidence of
+        :func:`segments_with_confidence`).
+    min_lengths : ndarray of shape (n_classes,) or None, default=None
+        Shortest run kept per class, in frames; None keeps every length.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        A filtered copy.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._decoding import reject_runs
+    >>> lab = np.array([0, 1, 1, 0, 2, 2, 2, 0])
+    >>> raw = np.eye(3)[lab] * 0.9 + 0.1 / 3
+    >>> reject_runs(lab, raw, np.arange(3), min_lengths=np.array([0, 3, 3])).tolist()
+    [0, 0, 0, 0, 2, 2, 2, 0]
+    >>> reject_runs(lab, raw, np.arange(3), min_confidence=0.95).tolist()
+    [0, 0, 0, 0, 0, 0, 0, 0]
+    """
+    labels = np.array(labels, copy=True)
+    if min_confidence <= 0 and min_lengths is None:
+        return labels
+    classes = np.asarray(classes)
+    starts, ends, values = runs(labels)
+    for s, e, v in zip(starts.tolist(), ends.tolist(), values.tolist()):
+        if v == 0:
+            continue
+        k = int(np.searchsorted(classes, v))
+        too_short = min_lengths is not None and e - s < min_lengths[k]
+        if too_short or (min_confidence > 0 and raw[s:e, k].mean() < min_confidence):
+            labels[s:e] = 0
+    return labels
+
+
 def decode(
     proba,
     classes,
@@ -108,6 +214,9 @@ def decode(
     min_run=1,
     max_gap=0,
     untracked=None,
+    min_confidence=0.0,
+    min_lengths=None,
+    raw=None,
 ):
     """Per-frame labels of one sequence from its class probabilities.
 
@@ -128,6 +237,14 @@ def decode(
         are filled before the ``min_run`` filter.
     untracked : ndarray of bool of shape (n_frames,) or None, default=None
         Frames forced to rest (lost tracking is never a gesture).
+    min_confidence : float, default=0.0
+        Gesture runs whose mean raw probability is lower become rest
+        (:func:`reject_runs`), after the ``min_run`` filter.
+    min_lengths : ndarray of shape (n_classes,) or None, default=None
+        Shortest run kept per class (:func:`reject_runs`).
+    raw : ndarray of shape (n_frames, n_classes) or None, default=None
+        The raw probabilities of those two rules when ``proba`` is already
+        smoothed (a stream's); None: ``proba``.
 
     Returns
     -------
@@ -152,7 +269,13 @@ def decode(
     labels = remove_short_runs(labels, min_run)
     if untracked is not None and np.any(untracked):
         labels[untracked] = 0
-    return labels
+    return reject_runs(
+        labels,
+        proba if raw is None else raw,
+        classes,
+        min_confidence=min_confidence,
+        min_lengths=min_lengths,
+    )
 
 
 def segments_with_confidence(labels, proba, classes):
@@ -243,6 +366,10 @@ class LabelRuns:
         A stretch this long without a cut is decided as if the stream ended
         there (bounds memory on a stream that never rests; offline has no
         such cap). None: no cap.
+    min_confidence : float, default=0.0
+    min_lengths : ndarray of shape (n_classes,) or None, default=None
+        The run rules of :func:`reject_runs`: they judge each run on its own,
+        so they move no cut.
 
     Examples
     --------
@@ -262,10 +389,20 @@ class LabelRuns:
     [0, 0, 1, 1, 1, 1, 1, 0, 0, 0, 2, 2, 2, 0]
     """
 
-    def __init__(self, classes, min_run, max_gap=0, max_run=None):
+    def __init__(
+        self,
+        classes,
+        min_run,
+        max_gap=0,
+        max_run=None,
+        min_confidence=0.0,
+        min_lengths=None,
+    ):
         self.classes = np.asarray(classes)
         self.min_run = int(min_run)
         self.max_gap = int(max_gap)
+        self.min_confidence = float(min_confidence)
+        self.min_lengths = min_lengths
         self.max_run = None if max_run is None else max(int(max_run), 1)
         n = len(self.classes)
         self.smoothed = RowBuffer((n,), capacity=64)
@@ -328,6 +465,7 @@ class LabelRuns:
             return
         if self.gestures:
             rest = self.rest.data(cs, b)
+            raw = self.raw.data(cs, b)
             labels = decode(
                 self.smoothed.data(cs, b),
                 self.classes,
@@ -335,9 +473,12 @@ class LabelRuns:
                 min_run=self.min_run,
                 max_gap=self.max_gap,
                 untracked=rest,
+                min_confidence=self.min_confidence,
+                min_lengths=self.min_lengths,
+                raw=raw,
             )
             for cls, s, e, conf in segments_with_confidence(
-                labels, self.raw.data(cs, b), self.classes
+                labels, raw, self.classes
             ).tolist():
                 out.append(StreamSegment(int(cls), cs + int(s), cs + int(e), conf, now))
         self.cs = b

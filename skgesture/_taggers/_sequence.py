@@ -115,6 +115,14 @@ class SequenceTagger(_BaseTagger):
         Shortest gesture run kept, in frames.
     max_gap : int, default=0
         Longest rest gap filled between two runs of one class.
+    min_confidence : float, default=0.0
+        Gesture runs whose mean raw probability of their class (the
+        confidence of ``predict_segments``) is lower become rest; in [0, 1].
+    min_duration : float, default=0.0
+        Gesture runs shorter than this fraction of their class's short
+        gesture (``class_lengths_``: the 10th percentile of its run lengths
+        in ``fit``) become rest. Everyday motion that the network takes for a
+        gesture is mostly briefer than the gesture.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a network reading a window (the TCN, or
@@ -151,6 +159,9 @@ class SequenceTagger(_BaseTagger):
     ----------
     classes_ : ndarray of shape (n_classes,)
         Labels seen in ``fit``, rest (0) first.
+    class_lengths_ : ndarray of shape (n_classes,)
+        The 10th percentile of every class's run lengths in ``fit``, in
+        frames (0 for rest), the unit of ``min_duration``.
     net_ : skorch.NeuralNet
         The trained network (``net_.history`` holds the losses).
     mean_ : ndarray of shape (n_features,)
@@ -269,6 +280,8 @@ class SequenceTagger(_BaseTagger):
         smoothing="mean",
         min_run=1,
         max_gap=0,
+        min_confidence=0.0,
+        min_duration=0.0,
         stream_past=32,
         stream_future=8,
         memory=None,
@@ -302,6 +315,8 @@ class SequenceTagger(_BaseTagger):
         self.smoothing = smoothing
         self.min_run = min_run
         self.max_gap = max_gap
+        self.min_confidence = min_confidence
+        self.min_duration = min_duration
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.memory = memory

@@ -33,12 +33,7 @@ class TaggerStream:
         self.smoother = LoessStepper(
             tagger.smooth_span, n, owner="BiLSTMTagger.smooth_span"
         )
-        self.runs = LabelRuns(
-            self.classes,
-            tagger.min_run,
-            max_gap=getattr(tagger, "max_gap", 0),
-            max_run=max_run,
-        )
+        self.runs = LabelRuns(self.classes, max_run=max_run, **tagger._run_rules())
         self.D = None  # descriptor rows of the chunks to come
         self.raw = RowBuffer((n,), capacity=64)  # released probabilities
         self.sums = np.zeros((self.window + self.chunk_step, n))
@@ -254,6 +249,8 @@ class TrailingWindowStream:
         :class:`LabelRuns`).
     owner : str, default="smooth_span"
         Parameter name for error messages.
+    **run_rules : dict
+        ``min_confidence`` and ``min_lengths`` of :class:`LabelRuns`.
 
     Examples
     --------
@@ -283,6 +280,7 @@ class TrailingWindowStream:
         max_gap=0,
         max_run=None,
         owner="smooth_span",
+        **run_rules,
     ):
         self.scorer = (
             proba if hasattr(proba, "reset") else WindowScorer(proba, lookback)
@@ -292,7 +290,9 @@ class TrailingWindowStream:
         self.lookback = int(self.scorer.lookback)
         self.lookahead = int(lookahead)
         self.smoother = make_smoother(smoothing, span, len(self.classes), owner=owner)
-        self.runs = LabelRuns(self.classes, min_run, max_gap=max_gap, max_run=max_run)
+        self.runs = LabelRuns(
+            self.classes, min_run, max_gap=max_gap, max_run=max_run, **run_rules
+        )
         self.delay = self.lookahead + self.smoother.h + int(max_gap) + 1
         self.X = None
         self.raw = RowBuffer((len(self.classes),), capacity=64)

@@ -42,6 +42,14 @@ class VotingTagger(_BaseTagger):
         Shortest gesture run kept, in frames.
     max_gap : int, default=0
         Longest rest gap filled between two runs of one class.
+    min_confidence : float, default=0.0
+        Gesture runs whose mean raw probability of their class (the
+        confidence of ``predict_segments``) is lower become rest; in [0, 1].
+    min_duration : float, default=0.0
+        Gesture runs shorter than this fraction of their class's short
+        gesture (``class_lengths_``: the 10th percentile of its run lengths
+        in ``fit``) become rest. Everyday motion that the network takes for a
+        gesture is mostly briefer than the gesture.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a member reading a window (a TCN, or any
@@ -64,6 +72,9 @@ class VotingTagger(_BaseTagger):
         The fitted taggers.
     classes_ : ndarray of shape (n_classes,)
         Labels seen in ``fit``, rest (0) first.
+    class_lengths_ : ndarray of shape (n_classes,)
+        The 10th percentile of every class's run lengths in ``fit``, in
+        frames (0 for rest), the unit of ``min_duration``.
     n_features_in_ : int
         Number of features per frame.
     frame_shape_in_ : tuple of int
@@ -105,6 +116,8 @@ class VotingTagger(_BaseTagger):
         smoothing="mean",
         min_run=1,
         max_gap=0,
+        min_confidence=0.0,
+        min_duration=0.0,
         stream_past=32,
         stream_future=8,
         n_threads=1,
@@ -116,6 +129,8 @@ class VotingTagger(_BaseTagger):
         self.smoothing = smoothing
         self.min_run = min_run
         self.max_gap = max_gap
+        self.min_confidence = min_confidence
+        self.min_duration = min_duration
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.n_threads = n_threads

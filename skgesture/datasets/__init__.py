@@ -11,7 +11,7 @@ names class ``k``), ``layout`` (``"kinect_v1"``) and ``DESCR``.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from skgesture.datasets._background import make_background
+from skgesture.datasets._background import SyntheticBackground, make_background
 from skgesture.datasets._base import DataFileWarning, DataFormatError
 from skgesture.datasets._chalearn import (
     CHALEARN_GESTURE_NAMES,
@@ -42,6 +42,7 @@ __all__ = [
     "MSR_ACTION3D_ACTION_NAMES",
     "MSR_ACTION3D_TO_KINECT_V1",
     "PRECOG_ACTION_NAMES",
+    "SyntheticBackground",
     "UTKINECT_ACTION_NAMES",
     "load_chalearn",
     "load_msr_action3d",

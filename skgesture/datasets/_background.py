@@ -12,6 +12,7 @@ out, so the negatives never teach the model to reject its own gestures
 
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
+from sklearn.base import BaseEstimator
 from sklearn.utils import Bunch, check_random_state
 
 from skgesture.datasets._synthetic import _check_int, _check_real
@@ -23,7 +24,7 @@ from skgesture.utils._validation import (
     untracked_rows,
 )
 
-__all__ = ["make_background"]
+__all__ = ["SyntheticBackground", "make_background"]
 
 
 BACKGROUND_KINDS = ("motion", "reversed", "fragment", "concatenation")
@@ -497,3 +498,83 @@ moves every coordinate {motion_scale:g} times as much as in the gestures;
 reversed gestures and concatenations that resemble a gesture of the
 recordings are left out.
 """
+
+
+class SyntheticBackground(BaseEstimator):
+    """Background sequences made in ``fit``, from the training recordings.
+
+    The parameters of :func:`make_background`, as an object a
+    :class:`~skgesture.GesturePipeline` takes (``background=``): each ``fit``
+    makes the sequences from the recordings it is given and adds them, all
+    rest, to its training data. In a cross-validation or a grid search the
+    negatives of every training fold are thus made from that fold only (no
+    test gesture leaks into them), and their parameters can be searched
+    (``background__motion_scale``), or the background switched off
+    (``background=None``).
+
+    Parameters
+    ----------
+    n_sequences : int, default=12
+        Sequences made at every ``fit``.
+    n_frames : int or None, default=None
+        Length of every sequence (see :func:`make_background`).
+    kinds : sequence of str or None, default=None
+        The kinds of piece (see :func:`make_background`); None: all.
+    motion_scale : float, default=0.5
+        Amplitude of the random joint motion (see :func:`make_background`).
+    random_state : int, RandomState instance or None, default=None
+        Controls every draw. Pass an int for the same sequences at every fit
+        on the same data.
+
+    See Also
+    --------
+    make_background : The function it calls.
+
+    Examples
+    --------
+    >>> from skgesture.datasets import SyntheticBackground, make_gesture_streams
+    >>> data = make_gesture_streams(n_sequences=4, n_classes=5, random_state=0)
+    >>> bg = SyntheticBackground(n_sequences=3, random_state=0).make(data.X, data.y)
+    >>> len(bg.X), all((lab == 0).all() for lab in bg.y)
+    (3, True)
+    """
+
+    def __init__(
+        self,
+        n_sequences=12,
+        *,
+        n_frames=None,
+        kinds=None,
+        motion_scale=0.5,
+        random_state=None,
+    ):
+        self.n_sequences = n_sequences
+        self.n_frames = n_frames
+        self.kinds = kinds
+        self.motion_scale = motion_scale
+        self.random_state = random_state
+
+    def make(self, X, y):
+        """The background sequences of the recordings ``X``, ``y``.
+
+        Parameters
+        ----------
+        X : list of array-like of shape (n_frames_i, ...)
+            The training recordings.
+        y : list of array-like of shape (n_frames_i,)
+            Their per-frame labels, 0 = rest; at least one gesture.
+
+        Returns
+        -------
+        :class:`~sklearn.utils.Bunch`
+            As :func:`make_background` returns it (``X``, ``y`` all zeros, ...).
+        """
+        return make_background(
+            X,
+            y,
+            n_sequences=self.n_sequences,
+            n_frames=self.n_frames,
+            kinds=self.kinds,
+            motion_scale=self.motion_scale,
+            random_state=self.random_state,
+        )

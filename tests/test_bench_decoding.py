@@ -1,0 +1,232 @@
+"""The ``decoding`` benchmark section runs in quick mode on tiny data.
+
+Synthetic streams and a tiny tagger: no shared data, a few seconds. Checks the
+rows' keys and ranges, the current default row (present once, zero change),
+that the worst case is the smallest change over the datasets, the chosen
+rule, that false events never rise with ``min_confidence``, that the default
+row is what the fitted pipeline itself predicts, that the figure is written to
+the folder asked for, and that a second run (with another grid) decodes the
+cached probabilities without fitting again.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import itertools
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+pytest.importorskip("torch")
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+import bench_decoding  # noqa: E402
+
+from skgesture import GesturePipeline  # noqa: E402
+from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
+
+KEYS = {
+    "table",
+    "setting",
+    "label",
+    "default",
+    "chosen",
+    "jaccard",
+    "jaccard_sd",
+    "jaccard_change",
+    "worst_change",
+    "worst_dataset",
+    "recall",
+    "recall_sd",
+    "gestures",
+    "events_per_min",
+    "events_per_min_sd",
+    "events_per_min_by",
+    "events",
+    "minutes",
+    "runs",
+}
+PARAMS = bench_decoding.PARAMS
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    """The quick run, and the pipelines it fitted (in the order of the fits)."""
+    out = tmp_path_factory.mktemp("decoding")
+    fitted = []
+    fit = GesturePipeline.fit
+
+    def recording_fit(self, *args, **kwargs):
+        fitted.append(self)
+        return fit(self, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(GesturePipeline, "fit", recording_fit)
+        rows = bench_decoding.run(quick=True, out_dir=out)
+    return out, rows, fitted
+
+
+def _settings(rows):
+    return [r for r in rows if r["table"] == "decoding"]
+
+
+def test_rows_keys_and_ranges(quick_run):
+    _, rows, fitted = quick_run
+    table = _settings(rows)
+    grid = bench_decoding.QUICK_GRID
+    expected = [dict(zip(PARAMS, v)) for v in itertools.product(*map(grid.get, PARAMS))]
+    assert sorted(map(str, (r["setting"] for r in table))) == sorted(map(str, expected))
+    assert len(fitted) == len(bench_decoding.QUICK_DATASETS)  # one fold, one seed
+    datasets = set(bench_decoding.QUICK_DATASETS)
+    negatives = {"synthetic A", "synthetic B"}
+    for r in table:
+        assert set(r) == KEYS
+        assert set(r["jaccard"]) == set(r["jaccard_change"]) == datasets
+        assert r["runs"] == dict.fromkeys(datasets, "1x1")
+        for d in datasets:
+            assert 0.0 <= r["jaccard"][d] <= 1.0
+            assert -1.0 <= r["jaccard_change"][d] <= 1.0
+            assert np.isnan(r["jaccard_sd"][d])  # one seed: no spread
+        assert 0.0 <= r["recall"] <= 1.0 and r["gestures"] > 0
+        assert np.isfinite(r["events_per_min"]) and r["events_per_min"] >= 0.0
+        assert set(r["events_per_min_by"]) == negatives
+        assert r["minutes"] > 0.0
+        assert r["events"] == pytest.approx(r["events_per_min"] * r["minutes"])
+        assert r["label"] == ", ".join(f"{p}={r['setting'][p]:g}" for p in PARAMS)
+    assert sum(r["chosen"] for r in table) == 1
+
+
+def test_default_row_has_zero_change(quick_run):
+    _, rows, _ = quick_run
+    table = _settings(rows)
+    defaults = [r for r in table if r["default"]]
+    assert len(defaults) == 1
+    (default,) = defaults
+    tagger = bench_decoding.skgesture.make_recommended().named_steps["tagger"]
+    assert default["setting"] == {p: tagger.get_params()[p] for p in PARAMS}
+    assert default["setting"] == bench_decoding.current_default()
+    assert all(v == 0.0 for v in default["jaccard_change"].values())
+    assert default["worst_change"] == 0.0
+    for r in table:  # one seed: the change is the difference of the Jaccards
+        for d, change in r["jaccard_change"].items():
+            assert change == pytest.approx(r["jaccard"][d] - default["jaccard"][d])
+
+
+def test_worst_case_is_the_smallest_change(quick_run):
+    _, rows, _ = quick_run
+    table = _settings(rows)
+    for r in table:
+        changes = r["jaccard_change"]
+        assert r["worst_change"] == min(changes.values())
+        assert changes[r["worst_dataset"]] == r["worst_change"]
+    # the datasets disagree somewhere, so the minimum is a choice
+    assert any(
+        min(r["jaccard_change"].values()) < max(r["jaccard_change"].values())
+        for r in table
+    )
+    worst = [r["worst_change"] for r in table]
+    assert worst == sorted(worst, reverse=True)  # the table's order
+
+
+def test_chosen_rule(quick_run):
+    _, rows, _ = quick_run
+    table = _settings(rows)
+    (chosen,) = [r for r in table if r["chosen"]]
+    tol = bench_decoding.TOLERANCE
+    assert chosen["worst_change"] >= -tol
+    eligible = [r for r in table if r["worst_change"] >= -tol]
+    assert chosen["events_per_min"] == min(r["events_per_min"] for r in eligible)
+    # some setting fires less but loses more than the tolerance somewhere
+    assert any(
+        r["events_per_min"] < chosen["events_per_min"] and r["worst_change"] < -tol
+        for r in table
+    )
+    notes = [n for n in bench_decoding.NOTES if n.startswith("chosen")]
+    assert len(notes) == 1 and chosen["label"] in notes[0]
+
+
+def test_false_events_do_not_rise_with_min_confidence(quick_run):
+    _, rows, _ = quick_run
+    groups = defaultdict(list)
+    for r in _settings(rows):
+        others = tuple(r["setting"][p] for p in PARAMS if p != "min_confidence")
+        groups[others].append(r)
+    drops = 0
+    for key, group in groups.items():
+        group.sort(key=lambda r: r["setting"]["min_confidence"])
+        levels = [r["setting"]["min_confidence"] for r in group]
+        assert levels == list(bench_decoding.QUICK_GRID["min_confidence"]), key
+        events = [r["events_per_min"] for r in group]
+        assert all(b <= a for a, b in zip(events, events[1:])), key
+        drops += events[-1] < events[0]
+    assert drops > 0  # the floor removes events, so the check bites
+
+
+def test_default_row_is_what_the_pipeline_predicts(quick_run):
+    """The cached probabilities, decoded with the defaults, give the fitted
+    pipeline's own ``predict`` / ``predict_segments`` (synthetic B at 15 fps:
+    resampled to the model's 20 and mapped back)."""
+    _, rows, fitted = quick_run
+    (default,) = [r for r in _settings(rows) if r["default"]]
+    folds_of, negatives = bench_decoding.quick_datasets()
+    name = bench_decoding.QUICK_REFERENCE
+    model = fitted[list(folds_of).index(name)]
+    data = folds_of[name].data
+    (_, _, te) = folds_of[name].folds[0]
+    X_te, y_te = [data.X[i] for i in te], [data.y[i] for i in te]
+    pred = model.predict(X_te, fps=data.fps)
+    assert default["jaccard"][name] == pytest.approx(jaccard_index(y_te, pred))
+    truth = [bench_decoding.true_gestures(data.segments[i]) for i in te]
+    found = event_recall(truth, model.predict_segments(X_te, fps=data.fps))
+    assert default["recall"] == pytest.approx(found)
+    assert model.fps_ != negatives["synthetic B"].fps[0]
+    for neg_name, neg in negatives.items():
+        segments = model.predict_segments(neg.X, fps=neg.fps)
+        count = sum(len(s) for s in segments)
+        assert default["events_per_min_by"][neg_name] == pytest.approx(
+            count / neg.minutes
+        )
+
+
+def test_figure_and_tables(quick_run):
+    out, rows, _ = quick_run
+    figures = [r for r in rows if r["table"] == "figure"]
+    assert len(figures) == 1
+    path = Path(figures[0]["path"])
+    assert path.parent == out and path.name == "decoding_quick.png"
+    assert path.is_file() and path.stat().st_size > 0
+    text = bench_decoding.format_tables(rows, "decoding")
+    lines = [line for line in text.splitlines() if line.startswith("| ")]
+    assert len(lines) == 1 + len(_settings(rows))  # the header and a row each
+    assert "jaccard quick A" in lines[0] and "false events/min" in lines[0]
+    marks = [line.split("|")[1].strip() for line in lines[1:]]
+    assert sorted(m for m in marks if m) in (["chosen", "default"], ["default, chosen"])
+    assert str(path) in text
+
+
+def test_second_run_reads_the_cache(quick_run, monkeypatch, tmp_path):
+    out, rows, _ = quick_run
+    cells = sorted(out.rglob("*.npz"))
+    assert len(cells) == len(bench_decoding.QUICK_DATASETS)
+
+    def no_fit(self, *args, **kwargs):
+        raise RuntimeError("fit called")
+
+    monkeypatch.setattr(GesturePipeline, "fit", no_fit)
+    with pytest.raises(RuntimeError, match="fit called"):  # the patch bites
+        bench_decoding.run(quick=True, out_dir=tmp_path)
+    grid = {"smooth_span": (1,), "min_run": (1,), "min_confidence": (0.0, 0.9)}
+    grid["min_duration"] = (bench_decoding.current_default()["min_duration"],)
+    again = bench_decoding.run(quick=True, grid=grid, out_dir=out)  # another grid
+    assert sorted(out.rglob("*.npz")) == cells
+    first = {r["label"]: r for r in _settings(rows)}
+    second = _settings(again)
+    assert len(second) == 2
+    for r in second:
+        old = first[r["label"]]
+        for key in ("jaccard", "jaccard_change", "recall", "events_per_min", "events"):
+            assert r[key] == old[key], key
