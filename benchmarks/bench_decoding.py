@@ -74,9 +74,13 @@ negatives (``synthetic B`` resampled to 15 fps, so that the rate path runs);
 ``bench_oov.make_model``'s tiny tagger, seed 0, ``QUICK_GRID``. Its cache goes
 under the output folder too.
 
+``--background synthetic`` fits ``make_recommended(background="synthetic")``
+instead (12 synthetic negatives made from every training fold): the same table
+for that model, in cache cells and a figure of its own.
+
 Usage: ``python benchmarks/bench_decoding.py [--quick] [--seeds 0,1,2]
-[--datasets precog,utkinect,synthetic] [--out-dir DIR]``, or ``python
-benchmarks/run.py --only decoding``.
+[--datasets precog,utkinect,synthetic] [--out-dir DIR] [--background
+synthetic]``, or ``python benchmarks/run.py --only decoding``.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -219,12 +223,19 @@ def true_gestures(segments):
 # ---------------------------------------------------------------- fitting
 
 
-def build_model(joints, seed, quick):
-    """``make_recommended(joints=joints, random_state=seed)``; quick:
-    ``bench_oov.make_model``'s tiny tagger (20 joints)."""
+def build_model(joints, seed, quick, background=None):
+    """``make_recommended(joints=joints, random_state=seed, background=...)``;
+    quick: ``bench_oov.make_model``'s tiny tagger (20 joints), with the same
+    background."""
     if quick:
-        return make_model(seed, quick=True)
-    return skgesture.make_recommended(joints=joints, random_state=seed)
+        model = make_model(seed, quick=True)
+        if background is not None:
+            made = skgesture.make_recommended(background=background, random_state=seed)
+            model.set_params(background=made.background)
+        return model
+    return skgesture.make_recommended(
+        joints=joints, random_state=seed, background=background
+    )
 
 
 def model_rate_proba(model, X, rates):
@@ -286,11 +297,12 @@ def cache_key(sizes):
     return h.hexdigest()[:12]
 
 
-def _cell_path(cache_dir, folds, joints, seed, fold_id, key):
+def _cell_path(cache_dir, folds, joints, seed, fold_id, key, background=None):
+    bg = "" if background is None else f"-bg{background}"
     return (
         cache_dir
         / f"{folds.name}-{folds.key}"
-        / f"{joints}-seed{seed}-{fold_id}-{key}.npz"
+        / f"{joints}{bg}-seed{seed}-{fold_id}-{key}.npz"
     )
 
 
@@ -534,7 +546,9 @@ def _datasets(quick, names):
     return folds, negatives
 
 
-def run(quick=False, seeds=None, datasets=None, grid=None, out_dir=None):
+def run(
+    quick=False, seeds=None, datasets=None, grid=None, out_dir=None, background=None
+):
     """Fit what is missing, decode every setting, return the rows (notes in
     ``NOTES``).
 
@@ -552,6 +566,10 @@ def run(quick=False, seeds=None, datasets=None, grid=None, out_dir=None):
     out_dir : path-like or None, default=None
         Folder of the figure and of the cache (``<out_dir>/decoding``); None:
         ``$SKG_BENCH_DECODING_DIR`` or ``bench_results/``.
+    background : None or "synthetic", default=None
+        ``make_recommended(background=...)`` of every fit: with
+        ``"synthetic"``, 12 negatives made from each training fold (its own
+        cache cells, its own figure).
 
     Returns
     -------
@@ -590,11 +608,13 @@ def run(quick=False, seeds=None, datasets=None, grid=None, out_dir=None):
         key = cache_key(sizes)
         scores[name] = {}
         for seed in seeds:
-            make = functools.partial(build_model, joints, seed, quick)
+            make = functools.partial(build_model, joints, seed, quick, background)
             for fold_id, tr, te in folds.folds:
                 data = folds.data
                 y_te = [data.y[i] for i in te]
-                path = _cell_path(cache_dir, folds, joints, seed, fold_id, key)
+                path = _cell_path(
+                    cache_dir, folds, joints, seed, fold_id, key, background
+                )
                 if path.exists():
                     cell = load_cell(path)
                 else:
@@ -626,9 +646,10 @@ def run(quick=False, seeds=None, datasets=None, grid=None, out_dir=None):
                 )
     rows = summarise(scores, settings, default, reference, negatives)
     _notes(rows, folds_of, negatives, reference, seeds, quick)
-    figure = plot_settings(
-        rows, out_dir / ("decoding_quick.png" if quick else "decoding.png")
-    )
+    if background is not None:
+        NOTES.append(f"every fit: make_recommended(background={background!r})")
+    stem = "decoding" + ("" if background is None else f"_bg{background}")
+    figure = plot_settings(rows, out_dir / f"{stem}{'_quick' if quick else ''}.png")
     rows.append({"table": "figure", "path": str(figure)})
     return rows
 
@@ -741,6 +762,12 @@ def main(argv=None):
     parser.add_argument(
         "--out-dir", default=None, help="figure and cache folder (bench_results/)"
     )
+    parser.add_argument(
+        "--background",
+        choices=["synthetic"],
+        default=None,
+        help="fit make_recommended(background='synthetic') instead of the default",
+    )
     args = parser.parse_args(argv)
     rows = run(
         quick=args.quick,
@@ -751,6 +778,7 @@ def main(argv=None):
             else None
         ),
         out_dir=args.out_dir,
+        background=args.background,
     )
     print(machine_line() + "\n")
     print(format_tables(rows))

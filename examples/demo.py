@@ -167,8 +167,8 @@ def main(argv=None):
         if args.method == "recommended":
             grid = {
                 "tagger__smooth_span": [1, 5, 9],
-                "tagger__min_run": [1, 4, 8],
-                "tagger__max_gap": [0, 4],
+                "tagger__min_run": [1, 8],
+                "tagger__min_duration": [0.0, 0.3, 0.5],
             }
         elif args.method == "B":
             grid = {

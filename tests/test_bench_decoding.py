@@ -230,3 +230,25 @@ def test_second_run_reads_the_cache(quick_run, monkeypatch, tmp_path):
         old = first[r["label"]]
         for key in ("jaccard", "jaccard_change", "recall", "events_per_min", "events"):
             assert r[key] == old[key], key
+
+
+def test_background_synthetic_fits_with_negatives_in_cells_of_its_own(tmp_path):
+    fitted = []
+    fit = GesturePipeline.fit
+
+    def recording_fit(self, *args, **kwargs):
+        fitted.append(self.background)
+        return fit(self, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(GesturePipeline, "fit", recording_fit)
+        rows = bench_decoding.run(
+            quick=True, datasets=["quick A"], out_dir=tmp_path, background="synthetic"
+        )
+    assert fitted and all(bg is not None for bg in fitted)
+    cells = sorted(tmp_path.rglob("*.npz"))
+    assert cells and all("-bgsynthetic-" in c.name for c in cells)
+    figure = next(r for r in rows if r["table"] == "figure")["path"]
+    assert Path(figure).name == "decoding_bgsynthetic_quick.png"
+    assert Path(figure).exists()
+    assert any("background='synthetic'" in n for n in bench_decoding.NOTES)

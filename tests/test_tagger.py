@@ -168,6 +168,12 @@ def test_decoding_parameters_change_predictions_without_retraining(toy, tmp_path
     second = cached.predict(X[5:])[0]
     assert not np.array_equal(first, second)
     assert set(np.unique(second)) <= {0, 1}
+    # the per-class length rule too: class_lengths_ comes back with the network
+    assert_lengths = cached.set_params(min_run=1, smooth_span=1, min_duration=0.8)
+    np.testing.assert_array_equal(cached.class_lengths_, tagger.class_lengths_)
+    for c, s, e, _ in assert_lengths.predict_segments(X[5:])[0]:
+        k = int(np.searchsorted(cached.classes_, c))
+        assert e - s >= 0.8 * cached.class_lengths_[k]
 
 
 def test_decode_rules():

@@ -22,6 +22,7 @@ from skgesture._nn._training import (  # noqa: E402
     SequenceSplit,
     held_out_sequences,
 )
+from skgesture.metrics import jaccard_index  # noqa: E402
 
 TAGGERS = {
     "bilstm": lambda **p: BiLSTMTagger(hidden_sizes=(4,), max_epochs=2, **p),
@@ -281,6 +282,30 @@ def test_min_duration_removes_brief_runs_and_keeps_the_gestures():
     for p in kept:
         assert not p[:15].any() and not p[45:].any()
         assert (p[22:38] == 1).all()
+    # the toy stream is then recognised near perfectly, the bursts as rest
+    y_test = _bursts(2, seed=5)[1]
+    assert jaccard_index(y_test, kept) >= 0.9 > jaccard_index(y_test, plain)
+
+
+def test_the_length_rule_scales_with_the_frame_rate():
+    # the short gesture is measured in frames of the training data: the same
+    # recordings at twice the rate give twice the lengths, and a model trained
+    # at either rate keeps the same gestures of a stream at its own rate
+    from skgesture import GesturePipeline
+    from skgesture._rate import resample
+
+    X, y = _streams(3)
+    fast = [resample(x, 30, 60) for x in X]
+    y_fast = [np.repeat(lab, 2)[: len(x)] for lab, x in zip(y, fast)]
+    slow_tagger = TRAINED["sequence"]().fit(X, y)
+    fast_tagger = TRAINED["sequence"]().fit(fast, y_fast)
+    assert_array_equal(fast_tagger.class_lengths_, 2 * slow_tagger.class_lengths_)
+    pipe = GesturePipeline([("tagger", slow_tagger)])
+    pipe.fps_ = 30.0
+    pipe[-1].set_params(min_duration=0.5)
+    x_test = _bursts(1, seed=5)[0][0]
+    at_60 = pipe.predict([resample(x_test, 30, 60)], fps=60)[0]
+    assert at_60[44:56].sum() > 0 and not at_60[:30].any()  # gesture kept, bursts not
 
 
 def test_min_confidence_drops_the_unsure_runs_only():
