@@ -29,7 +29,9 @@ Protocol
   without punches and kicks, MSRC-12 without its kick, UTKinect; each stream at
   its own rate).
 * **Decoding** (no refit): for every setting of ``GRID`` (smooth_span x min_run
-  x min_confidence x min_duration, 80 settings; the current default is added
+  x min_confidence x min_duration x viterbi_penalty, 320 settings, None being
+  the arg-max path; ``viterbi_duration`` and ``viterbi_lag`` stay the tagger's
+  defaults, 0.7 and 6; the current default is added
   when the grid lacks it) the parameters are set on the tagger
   (``tagger.set_params``) and ``tagger._decode(p, untracked)`` gives the
   labels, ``segments_with_confidence`` the events; labels go back to the
@@ -141,29 +143,25 @@ QUICK_DATASETS = ("quick A", "quick B")
 QUICK_REFERENCE = "quick A"
 QUICK_NEGATIVE_FPS = 15.0  # synthetic B is tested at this rate (quick mode)
 
-PARAMS = ("smooth_span", "min_run", "min_confidence", "min_duration")
+PARAMS = ("smooth_span", "min_run", "min_confidence", "min_duration", "viterbi_penalty")
 GRID = {
     "smooth_span": (1, 5),
     "min_run": (1, 6),
     "min_confidence": (0.0, 0.5, 0.7, 0.8, 0.9),
     "min_duration": (0.0, 0.2, 0.3, 0.5),
+    "viterbi_penalty": (None, 2.0, 5.0, 10.0),  # None: the arg-max path
 }
 QUICK_GRID = {
     "smooth_span": (1, 5),
     "min_run": (1,),
     "min_confidence": (0.0, 0.5, 0.9),
     "min_duration": (0.0, 0.3),
+    "viterbi_penalty": (None, 5.0),
 }
 TOLERANCE = 0.005  # the chosen setting loses at most this Jaccard anywhere
 PROBA_DTYPE = np.float32  # of the cache: the network's softmax is float32
 
-COLUMNS = [
-    "mark",
-    "smooth_span",
-    "min_run",
-    "min_confidence",
-    "min_duration",
-]  # then "jaccard <dataset>" per dataset, and TAIL_COLUMNS
+COLUMNS = ["mark", *PARAMS]  # then "jaccard <dataset>" per dataset, and TAIL_COLUMNS
 TAIL_COLUMNS = ["worst change", "worst on", "recall", "false events/min"]
 # Filled by run(): the notes printed under the table (skipped data, protocol).
 NOTES = []
@@ -339,11 +337,17 @@ def load_cell(path):
 # ---------------------------------------------------------------- decoding
 
 
+def fmt_value(value):
+    """A parameter's value in the table: ``"off"`` for None."""
+    return "off" if value is None else f"{value:g}"
+
+
 def settings_of(grid):
     """Every setting of ``grid`` (dicts over ``PARAMS``), the current default
     added when missing; and the index of the default."""
     default = current_default()
-    settings = [dict(zip(PARAMS, v)) for v in itertools.product(*map(grid.get, PARAMS))]
+    levels = [grid.get(p, (default[p],)) for p in PARAMS]  # absent: the default's
+    settings = [dict(zip(PARAMS, v)) for v in itertools.product(*levels)]
     if default not in settings:
         settings.append(default)
     return settings, settings.index(default)
@@ -439,7 +443,7 @@ def summarise(scores, settings, default, reference, negatives):
         row = {
             "table": "decoding",
             "setting": dict(setting),
-            "label": ", ".join(f"{p}={setting[p]:g}" for p in PARAMS),
+            "label": ", ".join(f"{p}={fmt_value(setting[p])}" for p in PARAMS),
             "default": k == default,
             "chosen": False,
             "jaccard": {},
@@ -705,7 +709,7 @@ def plot_settings(rows, path):
     ]
     ax.scatter(x, y, s=18, color="C0", label="a setting")
     for r, xi, yi in zip(rows, x, y):
-        short = ", ".join(f"{p} {r['setting'][p]:g}" for p in PARAMS)
+        short = ", ".join(f"{p} {fmt_value(r['setting'][p])}" for p in PARAMS)
         if r["default"]:
             label = f"current default: {short}"
             ax.plot(xi, yi, "s", ms=10, mfc="none", color="C3", label=label)
@@ -734,7 +738,7 @@ def format_tables(rows, title="Decoding defaults by their worst case"):
     for r in table:
         mark = [m for m in ("default", "chosen") if r[m]]
         line = {"mark": ", ".join(mark)}
-        line.update({p: f"{r['setting'][p]:g}" for p in PARAMS})
+        line.update({p: fmt_value(r["setting"][p]) for p in PARAMS})
         for d in datasets:
             line[f"jaccard {d}"] = _pm(r["jaccard"][d], r["jaccard_sd"][d], 3)
         line["worst change"] = f"{r['worst_change']:+.4f}"

@@ -96,7 +96,9 @@ def test_rows_keys_and_ranges(quick_run):
         assert set(r["events_per_min_by"]) == negatives
         assert r["minutes"] > 0.0
         assert r["events"] == pytest.approx(r["events_per_min"] * r["minutes"])
-        assert r["label"] == ", ".join(f"{p}={r['setting'][p]:g}" for p in PARAMS)
+        assert r["label"] == ", ".join(
+            f"{p}={bench_decoding.fmt_value(r['setting'][p])}" for p in PARAMS
+        )
     assert sum(r["chosen"] for r in table) == 1
 
 

@@ -255,3 +255,31 @@ def test_rejected_runs_stream_exactly(exact_model):
         got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
         assert_array_equal(got, segments[:, :3].astype(int))
         assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
+
+
+@pytest.mark.parametrize("lag", [0, 6])
+def test_the_viterbi_path_streams_exactly(exact_model, lag):
+    # the duration-aware path is decided at a fixed lag by the same steps
+    # offline and live: the events equal predict_segments, lag frames later
+    import copy
+
+    pipe = copy.deepcopy(exact_model[0])
+    X = exact_model[1]
+    tagger = pipe[-1]
+    F = pipe[:-1].transform(X)
+    plain = tagger.predict(F)
+    tagger.set_params(viterbi_penalty=3.0, viterbi_duration=0.7, viterbi_lag=lag)
+    after = tagger.predict_segments(F)
+    assert any(not np.array_equal(a, b) for a, b in zip(plain, tagger.predict(F)))
+    delays = []
+    for x, segments in zip(X, after):
+        rec = StreamingRecognizer(pipe)
+        events = rec.recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))
+        assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
+        delays += [e.emitted_at - (e.end - 1) for e in events if e.end < len(x)]
+    # the lag adds to the promised delay, and the events keep the promise
+    without = tagger.set_params(viterbi_penalty=None).stream_lookahead
+    assert rec.delays["tagger"] == without + lag
+    assert delays and max(delays) <= rec.max_delay

@@ -27,11 +27,13 @@ from skgesture._nn._training import IGNORE_INDEX, torch_threads
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._taggers._decoding import (
     SMOOTHINGS,
+    ViterbiRule,
     class_lengths,
     decode,
     segments_with_confidence,
 )
 from skgesture._taggers._stream import TrailingWindowStream
+from skgesture._taggers._viterbi import chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
 from skgesture.utils._validation import (
     check_sequence_labels,
@@ -57,6 +59,9 @@ _DECODING_CONSTRAINTS = {
     "max_gap": [Interval(Integral, 0, None, closed="left")],
     "min_confidence": [Interval(Real, 0, 1, closed="both")],
     "min_duration": [Interval(Real, 0, None, closed="left")],
+    "viterbi_penalty": [None, Interval(Real, 0, None, closed="left")],
+    "viterbi_duration": [Interval(Real, 0, None, closed="left")],
+    "viterbi_lag": [Interval(Integral, 0, None, closed="left")],
 }
 
 _STREAM_CONSTRAINTS = {
@@ -230,24 +235,35 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         return jaccard_index(y, self.predict(X))
 
     def _run_rules(self):
-        """The decoding rules on runs, for :func:`decode` and the stream's
-        :class:`~skgesture._taggers._decoding.LabelRuns` alike."""
+        """The decoding rules after the smoothing, for :func:`decode` and the
+        stream's :class:`~skgesture._taggers._decoding.LabelRuns` alike."""
         ratio = float(getattr(self, "min_duration", 0.0))
-        lengths = None
-        if ratio > 0:
+        penalty = getattr(self, "viterbi_penalty", None)
+        lengths = viterbi = None
+        if ratio > 0 or penalty is not None:
             fitted = getattr(self, "class_lengths_", None)
             if fitted is None:  # a model fitted before min_duration existed
+                name = f"min_duration={ratio}" if ratio > 0 else "viterbi_penalty"
                 raise ValueError(
-                    f"min_duration={ratio} needs class_lengths_, which this "
+                    f"{name} needs class_lengths_, which this "
                     f"{type(self).__name__} was fitted without: refit it, or set "
-                    "min_duration=0"
+                    "min_duration=0 and viterbi_penalty=None"
                 )
-            lengths = ratio * np.asarray(fitted, dtype=float)
+            fitted = np.asarray(fitted, dtype=float)
+            if ratio > 0:
+                lengths = ratio * fitted
+            if penalty is not None:
+                viterbi = ViterbiRule(
+                    chain_lengths(fitted, getattr(self, "viterbi_duration", 0.0)),
+                    penalty,
+                    getattr(self, "viterbi_lag", 0),
+                )
         return {
             "min_run": self.min_run,
             "max_gap": self.max_gap,
             "min_confidence": float(getattr(self, "min_confidence", 0.0)),
             "min_lengths": lengths,
+            "viterbi": viterbi,
         }
 
     def _decode(self, proba, untracked=None):
@@ -318,15 +334,18 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
     def stream_lookahead(self):
         """Frames between a gesture's last frame and its event, at most.
 
-        ``stream_future`` + the smoothing's look-ahead + ``max_gap`` + 1
-        (9 with the defaults).
+        ``stream_future`` + the smoothing's look-ahead + the Viterbi path's
+        ``viterbi_lag`` (when ``viterbi_penalty`` is set) + ``max_gap`` + 1.
         """
         from skgesture._taggers._decoding import make_smoother
 
         future = self._stream_future()
         name = f"{type(self).__name__}.smooth_span"
         h = make_smoother(self.smoothing, self.smooth_span, 1, owner=name).h
-        return int(future) + h + int(self.max_gap) + 1
+        lag = 0
+        if getattr(self, "viterbi_penalty", None) is not None:
+            lag = int(getattr(self, "viterbi_lag", 0))
+        return int(future) + h + lag + int(self.max_gap) + 1
 
     def _stream_future(self):
         """Frames after a frame that its probabilities wait for, live."""

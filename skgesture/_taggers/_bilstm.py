@@ -546,7 +546,8 @@ class BiLSTMTagger(_BaseTagger):
     smoothing = "loess"  # MATLAB-style loess of span smooth_span
     max_gap = 0  # no merging of split runs
     min_confidence = 0.0  # and the paper's rules only: no run rejected for
-    min_duration = 0.0  # its confidence or its class's length
+    min_duration = 0.0  # its confidence or its class's length,
+    viterbi_penalty = None  # and the arg-max of every frame
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y):

@@ -15,11 +15,15 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 
 from skgesture._stream import StreamSegment
+from skgesture._taggers._viterbi import ViterbiPath, log_scores
 from skgesture.utils._buffers import RowBuffer
 from skgesture.utils._segments import labels_to_segments, remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, MeanStepper, loess_smooth
 
 __all__ = [
+    "ViterbiRule",
+    "apply_run_rules",
+    "best_path",
     "class_lengths",
     "decode",
     "fill_short_gaps",
@@ -205,6 +209,94 @@ def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
     return labels
 
 
+def best_path(smoothed, classes, *, untracked=None, viterbi=None):
+    """The labels of every frame before the run rules: the arg-max of every
+    frame, or the duration-aware Viterbi path of ``viterbi``.
+
+    Parameters
+    ----------
+    smoothed : ndarray of shape (n_frames, n_classes)
+        (Smoothed) probabilities, columns in ``classes`` order.
+    classes : ndarray of shape (n_classes,)
+        Labels of the columns, rest (0) first.
+    untracked : ndarray of bool of shape (n_frames,) or None, default=None
+        Frames the Viterbi path keeps at rest.
+    viterbi : ViterbiRule or None, default=None
+        None: the arg-max.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        Labels from ``classes``.
+    """
+    classes = np.asarray(classes)
+    if viterbi is None:
+        return classes[np.argmax(smoothed, axis=1)]
+    return classes[viterbi.path().run(log_scores(smoothed, untracked))]
+
+
+def apply_run_rules(
+    labels,
+    raw,
+    classes,
+    *,
+    untracked=None,
+    min_run=1,
+    max_gap=0,
+    min_confidence=0.0,
+    min_lengths=None,
+):
+    """The rules of :func:`decode` that follow the path, on its labels.
+
+    Untracked frames become rest, rest gaps of at most ``max_gap`` frames
+    between two runs of one class are filled, gesture runs shorter than
+    ``min_run`` become rest, untracked frames are rest again, and
+    :func:`reject_runs` judges every run (``raw``: the raw probabilities).
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        A filtered copy of ``labels``.
+    """
+    labels = np.array(labels, copy=True)
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    labels = fill_short_gaps(labels, max_gap)
+    labels = remove_short_runs(labels, min_run)
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    return reject_runs(
+        labels,
+        raw,
+        classes,
+        min_confidence=min_confidence,
+        min_lengths=min_lengths,
+    )
+
+
+class ViterbiRule:
+    """The parameters of the duration-aware path (:mod:`._viterbi`).
+
+    Parameters
+    ----------
+    durations : ndarray of int of shape (n_classes,)
+        Shortest run of every class, in frames (rest first, 1).
+    penalty : float
+        Log score of entering a gesture.
+    lag : int
+        Frames between a frame and its decision.
+    """
+
+    def __init__(self, durations, penalty, lag):
+        self.durations = np.asarray(durations, dtype=np.int64)
+        self.penalty = float(penalty)
+        self.lag = int(lag)
+
+    def path(self):
+        """A fresh :class:`~skgesture._taggers._viterbi.ViterbiPath`."""
+        return ViterbiPath(self.durations, self.penalty, self.lag)
+
+
 def decode(
     proba,
     classes,
@@ -216,6 +308,7 @@ def decode(
     untracked=None,
     min_confidence=0.0,
     min_lengths=None,
+    viterbi=None,
     raw=None,
 ):
     """Per-frame labels of one sequence from its class probabilities.
@@ -242,6 +335,10 @@ def decode(
         (:func:`reject_runs`), after the ``min_run`` filter.
     min_lengths : ndarray of shape (n_classes,) or None, default=None
         Shortest run kept per class (:func:`reject_runs`).
+    viterbi : ViterbiRule or None, default=None
+        The labels before the rules: None, the arg-max of every frame; a
+        rule, the duration-aware Viterbi path decided at its lag
+        (:mod:`skgesture._taggers._viterbi`).
     raw : ndarray of shape (n_frames, n_classes) or None, default=None
         The raw probabilities of those two rules when ``proba`` is already
         smoothed (a stream's); None: ``proba``.
@@ -262,17 +359,14 @@ def decode(
     [0, 0, 0, 0, 0, 0, 0, 0]
     """
     smoothed = smooth_proba(proba, smooth_span, smoothing)
-    labels = np.asarray(classes)[np.argmax(smoothed, axis=1)]
-    if untracked is not None and np.any(untracked):
-        labels[untracked] = 0
-    labels = fill_short_gaps(labels, max_gap)
-    labels = remove_short_runs(labels, min_run)
-    if untracked is not None and np.any(untracked):
-        labels[untracked] = 0
-    return reject_runs(
+    labels = best_path(smoothed, classes, untracked=untracked, viterbi=viterbi)
+    return apply_run_rules(
         labels,
         proba if raw is None else raw,
         classes,
+        untracked=untracked,
+        min_run=min_run,
+        max_gap=max_gap,
         min_confidence=min_confidence,
         min_lengths=min_lengths,
     )
@@ -341,18 +435,22 @@ def make_smoother(smoothing, span, n_tracks, owner="smooth_span"):
 class LabelRuns:
     """The decoding of a tagger's smoothed scores, one stretch at a time.
 
-    The offline rules of :func:`skgesture._taggers._decoding.decode` (arg-max, rest on
-    masked rows, rest gaps of at most ``max_gap`` frames between two runs of
-    one class filled, gesture runs shorter than ``min_run`` set to rest) and
-    the segments and confidences of
-    :func:`skgesture._taggers._decoding.segments_with_confidence`, applied by calling
-    those functions on stretches of rows that no later row can change: the
-    stream is cut where the labels before and after cannot interact, i.e.
-    between two different gesture labels, before a gesture whose preceding
-    rest gap cannot be filled, and inside a rest run longer than ``max_gap``.
-    A run of one gesture is therefore emitted once ``max_gap + 1`` rest rows
-    follow it (its first rest row for ``max_gap=0``) or another gesture
-    starts; the segments equal the offline ones on the whole stream.
+    The offline rules of :func:`skgesture._taggers._decoding.decode`: the
+    path (:func:`best_path`: the arg-max of every row, or the duration-aware
+    Viterbi path, whose steps are the offline ones and decide a row ``lag``
+    rows after it), then the rules on its labels (:func:`apply_run_rules`:
+    rest on masked rows, rest gaps of at most ``max_gap`` frames between two
+    runs of one class filled, gesture runs shorter than ``min_run`` set to
+    rest, :func:`reject_runs`) and the segments and confidences of
+    :func:`skgesture._taggers._decoding.segments_with_confidence`, applied by
+    calling those functions on stretches of rows that no later row can
+    change: the stream is cut where the labels before and after cannot
+    interact, i.e. between two different gesture labels, before a gesture
+    whose preceding rest gap cannot be filled, and inside a rest run longer
+    than ``max_gap``. A run of one gesture is therefore emitted once ``max_gap
+    + 1`` rest rows follow it (its first rest row for ``max_gap=0``) or
+    another gesture starts, and those rows are decided; the segments equal
+    the offline ones on the whole stream.
 
     Parameters
     ----------
@@ -370,6 +468,8 @@ class LabelRuns:
     min_lengths : ndarray of shape (n_classes,) or None, default=None
         The run rules of :func:`reject_runs`: they judge each run on its own,
         so they move no cut.
+    viterbi : ViterbiRule or None, default=None
+        The path (:func:`best_path`); None: the arg-max.
 
     Examples
     --------
@@ -397,19 +497,24 @@ class LabelRuns:
         max_run=None,
         min_confidence=0.0,
         min_lengths=None,
+        viterbi=None,
     ):
         self.classes = np.asarray(classes)
         self.min_run = int(min_run)
         self.max_gap = int(max_gap)
         self.min_confidence = float(min_confidence)
         self.min_lengths = min_lengths
+        self.viterbi = viterbi
+        self.path = None if viterbi is None else viterbi.path()
+        self.lag = 0 if viterbi is None else viterbi.lag
         self.max_run = None if max_run is None else max(int(max_run), 1)
         n = len(self.classes)
-        self.smoothed = RowBuffer((n,), capacity=64)
+        self.labels = RowBuffer((), dtype=self.classes.dtype, capacity=64)
         self.raw = RowBuffer((n,), capacity=64)
         self.rest = RowBuffer((), dtype=bool, capacity=64)
         self.cs = 0  # first row of the stretch not yet decided
-        self.n = 0  # rows fed
+        self.n = 0  # rows labelled by the path
+        self.fed = 0  # rows fed
         self.gestures = 0  # gesture labels in the stretch
         self.label = 0  # label of the current run
         self.start = 0  # its first row
@@ -420,13 +525,24 @@ class LabelRuns:
         segments of the stretches they close out."""
         smoothed = np.asarray(smoothed)
         rest = np.asarray(rest, dtype=bool)
-        if lo != self.n:
-            raise IndexError(f"rows fed out of order: {lo}, expected {self.n}")
-        labels = self.classes[np.argmax(smoothed, axis=1)]
-        labels[rest] = 0
-        self.smoothed.append(smoothed)
+        if lo != self.fed:
+            raise IndexError(f"rows fed out of order: {lo}, expected {self.fed}")
+        self.fed = lo + len(smoothed)
         self.raw.append(raw, rest)
         self.rest.append(rest)
+        if self.path is None:
+            labels = self.classes[np.argmax(smoothed, axis=1)]
+        else:  # the rows decided by these: lag rows earlier
+            labels = self.classes[self.path.feed(log_scores(smoothed, rest))]
+            times = np.asarray(times)[len(times) - len(labels) :]
+        return self._label(labels, times)
+
+    def _label(self, labels, times):
+        """Labels of the next rows of the path in; the closed segments out."""
+        lo = self.n
+        labels = np.array(labels, copy=True)
+        labels[self.rest.data(lo, lo + len(labels))] = 0
+        self.labels.append(labels)
         out = []
         gap = self.max_gap
         for i, lab in enumerate(labels.tolist()):
@@ -452,30 +568,29 @@ class LabelRuns:
     def end(self, stop, now):
         """The stream ends at row ``stop``: the segments of the last stretch."""
         out = []
+        if self.path is not None:
+            last = self.classes[self.path.finish()]
+            out += self._label(last, np.full(len(last), int(now)))
         self._cut(stop, int(now), out)
         self.label, self.start, self.before = 0, stop, 0
         return out
 
     def _cut(self, b, now, out):
         """Decide rows ``cs .. b - 1`` with the offline functions."""
-        from skgesture._taggers._decoding import decode, segments_with_confidence
-
         cs = self.cs
         if b <= cs:
             return
         if self.gestures:
-            rest = self.rest.data(cs, b)
             raw = self.raw.data(cs, b)
-            labels = decode(
-                self.smoothed.data(cs, b),
+            labels = apply_run_rules(
+                self.labels.data(cs, b),
+                raw,
                 self.classes,
-                smoothing="none",  # the rows are already smoothed
+                untracked=self.rest.data(cs, b),
                 min_run=self.min_run,
                 max_gap=self.max_gap,
-                untracked=rest,
                 min_confidence=self.min_confidence,
                 min_lengths=self.min_lengths,
-                raw=raw,
             )
             for cls, s, e, conf in segments_with_confidence(
                 labels, raw, self.classes
@@ -483,9 +598,9 @@ class LabelRuns:
                 out.append(StreamSegment(int(cls), cs + int(s), cs + int(e), conf, now))
         self.cs = b
         self.gestures = 0
-        for buf in (self.smoothed, self.raw, self.rest):
+        for buf in (self.labels, self.raw, self.rest):
             buf.drop(b)
 
     def held(self):
         """Rows of the stretch not yet decided."""
-        return self.n - self.cs
+        return self.fed - self.cs

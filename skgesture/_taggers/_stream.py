@@ -222,8 +222,8 @@ class TrailingWindowStream:
     ``stream_init`` returns one; its ``stream_step`` and ``stream_flush`` call
     :meth:`step` and :meth:`flush`, and its ``stream_lookahead`` is
     :attr:`delay`,
-    ``lookahead + h + max_gap + 1`` (``h`` the smoothing's look-ahead,
-    ``(span - 1) // 2`` for loess).
+    ``lookahead + h + lag + max_gap + 1`` (``h`` the smoothing's look-ahead,
+    ``(span - 1) // 2`` for loess; ``lag`` the Viterbi path's, 0 without).
 
     Parameters
     ----------
@@ -250,7 +250,8 @@ class TrailingWindowStream:
     owner : str, default="smooth_span"
         Parameter name for error messages.
     **run_rules : dict
-        ``min_confidence`` and ``min_lengths`` of :class:`LabelRuns`.
+        ``min_confidence``, ``min_lengths`` and ``viterbi`` of
+        :class:`LabelRuns`.
 
     Examples
     --------
@@ -293,7 +294,7 @@ class TrailingWindowStream:
         self.runs = LabelRuns(
             self.classes, min_run, max_gap=max_gap, max_run=max_run, **run_rules
         )
-        self.delay = self.lookahead + self.smoother.h + int(max_gap) + 1
+        self.delay = self.lookahead + self.smoother.h + self.runs.lag + int(max_gap) + 1
         self.X = None
         self.raw = RowBuffer((len(self.classes),), capacity=64)
         self.n_out = 0  # frames whose probabilities are computed

@@ -50,6 +50,19 @@ class VotingTagger(_BaseTagger):
         gesture (``class_lengths_``: the 10th percentile of its run lengths
         in ``fit``) become rest. Everyday motion that the network takes for a
         gesture is mostly briefer than the gesture.
+    viterbi_penalty : float or None, default=None
+        None: the labels are the arg-max of every frame. A float: they are
+        the duration-aware Viterbi path (a gesture lasts at least
+        ``viterbi_duration`` of its class's short gesture, entering one costs
+        this many nats of log probability), decided ``viterbi_lag`` frames
+        after each frame, offline as live; one doubtful frame then neither
+        splits a gesture nor starts a brief false one (docs/design.md,
+        "Duration-aware decoding").
+    viterbi_duration : float, default=0.7
+        Shortest run of the path, as a fraction of ``class_lengths_``.
+    viterbi_lag : int, default=6
+        Frames between a frame and the path's decision on it (added to the
+        stream's delay).
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a member reading a window (a TCN, or any
@@ -118,6 +131,9 @@ class VotingTagger(_BaseTagger):
         max_gap=0,
         min_confidence=0.0,
         min_duration=0.0,
+        viterbi_penalty=None,
+        viterbi_duration=0.7,
+        viterbi_lag=6,
         stream_past=32,
         stream_future=8,
         n_threads=1,
@@ -131,6 +147,9 @@ class VotingTagger(_BaseTagger):
         self.max_gap = max_gap
         self.min_confidence = min_confidence
         self.min_duration = min_duration
+        self.viterbi_penalty = viterbi_penalty
+        self.viterbi_duration = viterbi_duration
+        self.viterbi_lag = viterbi_lag
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.n_threads = n_threads

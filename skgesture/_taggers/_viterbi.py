@@ -1,0 +1,219 @@
+"""Duration-aware Viterbi path of per-frame class scores, decided at a fixed lag.
+
+The arg-max of every frame's probabilities (the default path of
+:func:`skgesture._taggers._decoding.decode`) lets one noisy frame split a
+gesture in two or start a brief false one. This path instead reads the best
+sequence of labels under a small model of how gestures follow each other:
+
+* a gesture of class ``c`` lasts at least ``durations[c]`` frames (each class
+  is a chain of that many states, the last one looping on itself; rest is one
+  state), so a run shorter than the class's short gesture costs the whole
+  chain;
+* entering a gesture costs ``penalty`` (in nats, against the sum of the
+  frames' log probabilities); leaving it for rest costs nothing, and a
+  gesture may follow another directly (at the same cost).
+
+It is decided **at a fixed lag**: the label of frame ``t`` is the state at
+``t`` of the best path ending at frame ``t + lag`` (the last ``lag`` frames
+of a sequence are read off the best path ending at its last frame). Offline
+and live run the same steps (:class:`ViterbiPath`), so a stream decides every
+frame exactly as ``predict`` does, ``lag`` frames after it arrives; a full
+Viterbi would wait until every surviving path agrees, a median of 22 frames
+after a gesture's end on PRECOG (docs/design.md, "Duration-aware decoding").
+
+The forward step is one function, compiled by numba when it is installed and
+run as Python otherwise; both perform the same floating-point operations in
+the same order, so both give the same labels.
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import numpy as np
+
+__all__ = ["ViterbiPath", "chain_lengths", "log_scores"]
+
+NEG = -1e18  # log score of an unreachable state
+FLOOR = 1e-8  # probabilities are clipped here before the log
+MASKED = -1e9  # log score of a gesture on an untracked frame
+
+
+def _jit(func):
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - the minimal install
+        return func
+    return numba.njit(cache=True, nogil=True)(func)
+
+
+@_jit
+def _forward(delta, lp, first, last, cls, pen, lag, ring, t, out):
+    """Advance the path over the rows of ``lp``; write decided labels.
+
+    ``delta`` (n_states,) holds the best log score of a path ending in every
+    state at frame ``t - 1`` (unused when ``t == 0``); ``ring`` (lag + 1,
+    n_states) the back-pointers of the last frames, row ``(frame) % (lag +
+    1)``. ``out[i]`` gets the class index of frame ``t + i - lag`` once frame
+    ``t + i`` is read (-1 while ``t + i < lag``). Returns the next ``t``.
+    """
+    n_states = delta.shape[0]
+    n_classes = first.shape[0]
+    new = np.empty(n_states)
+    for i in range(lp.shape[0]):
+        row = (t + i) % (lag + 1)
+        bp = ring[row]
+        if t + i == 0:
+            for s in range(n_states):
+                delta[s] = NEG
+                bp[s] = s
+            for k in range(n_classes):
+                delta[first[k]] = lp[i, k] - (pen if k > 0 else 0.0)
+        else:
+            # the two best chain ends: where each class is entered from
+            b1 = 0
+            for k in range(1, n_classes):
+                if delta[last[k]] > delta[last[b1]]:
+                    b1 = k
+            b2 = 1 if b1 == 0 else 0
+            for k in range(n_classes):
+                if k != b1 and delta[last[k]] > delta[last[b2]]:
+                    b2 = k
+            for s in range(n_states):
+                new[s] = NEG
+            for k in range(n_classes):
+                f, e = first[k], last[k]
+                src = b2 if k == b1 else b1
+                entry = delta[last[src]] - (pen if k > 0 else 0.0)
+                for s in range(f + 1, e + 1):  # advance along the chain
+                    new[s] = delta[s - 1]
+                    bp[s] = s - 1
+                if f == e:  # one state: stay, or enter (ties stay)
+                    if delta[e] >= entry:
+                        new[e] = delta[e]
+                        bp[e] = e
+                    else:
+                        new[e] = entry
+                        bp[e] = last[src]
+                else:
+                    new[f] = entry
+                    bp[f] = last[src]
+                    if delta[e] > new[e]:  # the last state loops
+                        new[e] = delta[e]
+                        bp[e] = e
+            for s in range(n_states):
+                delta[s] = new[s] + lp[i, cls[s]]
+        if t + i >= lag:
+            s = 0
+            for q in range(1, n_states):
+                if delta[q] > delta[s]:
+                    s = q
+            for back in range(lag):
+                s = ring[(t + i - back) % (lag + 1)][s]
+            out[i] = cls[s]
+        else:
+            out[i] = -1
+    return t + lp.shape[0]
+
+
+@_jit
+def _trace_tail(delta, cls, lag, ring, t, out):
+    """Class indices of the last ``min(lag, t)`` frames (``out``, oldest
+    first), read off the best path ending at frame ``t - 1``."""
+    n_states = delta.shape[0]
+    m = out.shape[0]
+    s = 0
+    for q in range(1, n_states):
+        if delta[q] > delta[s]:
+            s = q
+    for back in range(m):
+        out[m - 1 - back] = cls[s]
+        s = ring[(t - 1 - back) % (lag + 1)][s]
+
+
+def chain_lengths(class_lengths, ratio):
+    """Frames each class lasts at least: ``ceil(ratio * class_lengths)``, at
+    least 1; rest (index 0) 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._viterbi import chain_lengths
+    >>> chain_lengths(np.array([0.0, 10.0, 3.0]), 0.7).tolist()
+    [1, 7, 3]
+    """
+    d = np.maximum(np.ceil(float(ratio) * np.asarray(class_lengths, float)), 1)
+    d = d.astype(np.int64)
+    d[0] = 1
+    return d
+
+
+def log_scores(proba, untracked=None):
+    """Log probabilities of the path (clipped at ``FLOOR``); a gesture on an
+    untracked frame is all but impossible."""
+    lp = np.log(np.clip(np.asarray(proba, dtype=np.float64), FLOOR, None))
+    if untracked is not None and np.any(untracked):
+        lp[np.asarray(untracked, dtype=bool), 1:] = MASKED
+    return np.ascontiguousarray(lp)
+
+
+class ViterbiPath:
+    """The duration-aware path, one block of frames at a time.
+
+    Parameters
+    ----------
+    durations : ndarray of int of shape (n_classes,)
+        Shortest run of every class, in frames (:func:`chain_lengths`); rest
+        (index 0) first.
+    penalty : float
+        Log score of entering a gesture.
+    lag : int
+        Frames between a frame and its decision.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._viterbi import ViterbiPath, log_scores
+    >>> p = np.tile([0.9, 0.1], (12, 1))
+    >>> p[3:9] = [0.1, 0.9]  # frames 3-8: class 1
+    >>> p[5] = [0.8, 0.2]  # one doubtful frame inside the gesture
+    >>> ViterbiPath(np.array([1, 4]), penalty=2.0, lag=3).run(log_scores(p)).tolist()
+    [0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0]
+    >>> p.argmax(axis=1).tolist()
+    [0, 0, 0, 1, 1, 0, 1, 1, 1, 0, 0, 0]
+    """
+
+    def __init__(self, durations, penalty, lag):
+        d = np.asarray(durations, dtype=np.int64)
+        self.last = np.cumsum(d) - 1
+        self.first = self.last - d + 1
+        self.cls = np.repeat(np.arange(len(d), dtype=np.int64), d)
+        self.penalty = float(penalty)
+        self.lag = int(lag)
+        self.delta = np.full(len(self.cls), NEG)
+        self.ring = np.zeros((self.lag + 1, len(self.cls)), dtype=np.int64)
+        self.t = 0  # frames read
+        self.decided = 0  # frames decided
+
+    def feed(self, lp):
+        """Log scores of the next frames in; the class indices of the frames
+        decided by them out (those ``lag`` frames earlier)."""
+        lp = np.ascontiguousarray(lp, dtype=np.float64)
+        out = np.empty(len(lp), dtype=np.int64)
+        self.t = _forward(
+            self.delta, lp, self.first, self.last, self.cls, self.penalty,
+            self.lag, self.ring, self.t, out,
+        )  # fmt: skip
+        out = out[out >= 0]
+        self.decided += len(out)
+        return out
+
+    def finish(self):
+        """The class indices of the frames not yet decided (the sequence ends)."""
+        out = np.empty(self.t - self.decided, dtype=np.int64)
+        if len(out):
+            _trace_tail(self.delta, self.cls, self.lag, self.ring, self.t, out)
+        self.decided = self.t
+        return out
+
+    def run(self, lp):
+        """Class indices of a whole sequence (``feed`` then ``finish``)."""
+        return np.concatenate([self.feed(lp), self.finish()])
