@@ -2,7 +2,8 @@
 
 One path for :class:`~skgesture.BiLSTMTagger` (Method C),
 :class:`~skgesture.SequenceTagger` and :class:`~skgesture.VotingTagger`:
-smooth every class track, take the arg-max per frame, merge runs of one class
+smooth every class track, take the arg-max per frame (or the duration-aware
+Viterbi path of :mod:`skgesture._taggers._viterbi`), merge runs of one class
 split by a short rest gap, set gesture runs shorter than ``min_run`` to rest,
 and force untracked frames to rest. Only the network depends on the training,
 so every decoding parameter can be changed after ``fit`` (and searched without
@@ -531,7 +532,7 @@ class LabelRuns:
         self.raw.append(raw, rest)
         self.rest.append(rest)
         if self.path is None:
-            labels = self.classes[np.argmax(smoothed, axis=1)]
+            labels = best_path(smoothed, self.classes)
         else:  # the rows decided by these: lag rows earlier
             labels = self.classes[self.path.feed(log_scores(smoothed, rest))]
             times = np.asarray(times)[len(times) - len(labels) :]

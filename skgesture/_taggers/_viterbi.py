@@ -28,6 +28,8 @@ the same order, so both give the same labels.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import functools
+
 import numpy as np
 
 __all__ = ["ViterbiPath", "chain_lengths", "log_scores"]
@@ -37,15 +39,6 @@ FLOOR = 1e-8  # probabilities are clipped here before the log
 MASKED = -1e9  # log score of a gesture on an untracked frame
 
 
-def _jit(func):
-    try:
-        import numba
-    except ImportError:  # pragma: no cover - the minimal install
-        return func
-    return numba.njit(cache=True, nogil=True)(func)
-
-
-@_jit
 def _forward(delta, lp, first, last, cls, pen, lag, ring, t, out):
     """Advance the path over the rows of ``lp``; write decided labels.
 
@@ -114,7 +107,6 @@ def _forward(delta, lp, first, last, cls, pen, lag, ring, t, out):
     return t + lp.shape[0]
 
 
-@_jit
 def _trace_tail(delta, cls, lag, ring, t, out):
     """Class indices of the last ``min(lag, t)`` frames (``out``, oldest
     first), read off the best path ending at frame ``t - 1``."""
@@ -127,6 +119,20 @@ def _trace_tail(delta, cls, lag, ring, t, out):
     for back in range(m):
         out[m - 1 - back] = cls[s]
         s = ring[(t - 1 - back) % (lag + 1)][s]
+
+
+@functools.cache
+def _kernels():
+    """``(_forward, _trace_tail)``, compiled by numba when it is installed.
+
+    Compiled on first use, so importing the taggers does not import numba.
+    """
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - the minimal install
+        return _forward, _trace_tail
+    jit = numba.njit(cache=True, nogil=True)
+    return jit(_forward), jit(_trace_tail)
 
 
 def chain_lengths(class_lengths, ratio):
@@ -198,7 +204,7 @@ class ViterbiPath:
         decided by them out (those ``lag`` frames earlier)."""
         lp = np.ascontiguousarray(lp, dtype=np.float64)
         out = np.empty(len(lp), dtype=np.int64)
-        self.t = _forward(
+        self.t = _kernels()[0](
             self.delta, lp, self.first, self.last, self.cls, self.penalty,
             self.lag, self.ring, self.t, out,
         )  # fmt: skip
@@ -210,7 +216,7 @@ class ViterbiPath:
         """The class indices of the frames not yet decided (the sequence ends)."""
         out = np.empty(self.t - self.decided, dtype=np.int64)
         if len(out):
-            _trace_tail(self.delta, self.cls, self.lag, self.ring, self.t, out)
+            _kernels()[1](self.delta, self.cls, self.lag, self.ring, self.t, out)
         self.decided = self.t
         return out
 
