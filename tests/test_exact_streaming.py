@@ -247,9 +247,25 @@ def test_rejected_runs_stream_exactly(exact_model):
     tagger = pipe[-1]
     F = pipe[:-1].transform(X)
     before = np.concatenate(tagger.predict_segments(F))
-    tagger.set_params(min_confidence=float(np.median(before[:, 3])), min_duration=0.8)
+    # the longest run, too long for its class (max_duration)
+    longest = before[np.argmax(before[:, 2] - before[:, 1])]
+    k = int(np.searchsorted(tagger.classes_, longest[0]))
+    too_long = (longest[2] - longest[1] - 0.5) / tagger.class_long_lengths_[k]
+    # a floor between two confidences: at a tie, float32 live against float64
+    # offline sums may fall either side of it
+    conf = np.unique(before[:, 3])
+    floor = float(conf[len(conf) // 2 - 1 : len(conf) // 2 + 1].mean())
+    tagger.set_params(
+        min_confidence=floor,
+        min_duration=0.8,
+        max_duration=float(too_long),
+    )
     after = tagger.predict_segments(F)
     assert 0 < sum(len(s) for s in after) < len(before)
+    assert not any(
+        ((s[:, 0] == longest[0]) & (s[:, 2] - s[:, 1] >= longest[2] - longest[1])).any()
+        for s in after
+    )
     for x, segments in zip(X, after):
         events = StreamingRecognizer(pipe).recognize(x)
         got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)

@@ -308,6 +308,25 @@ def test_the_length_rule_scales_with_the_frame_rate():
     assert at_60[44:56].sum() > 0 and not at_60[:30].any()  # gesture kept, bursts not
 
 
+def test_max_duration_removes_runs_far_longer_than_the_gesture():
+    # a 20-frame gesture is learnt; the same motion held for 80 frames (an
+    # activity, not a command) is a gesture to the network, and rest once a
+    # run may last at most twice the class's long gesture
+    tagger = TRAINED["sequence"]().fit(*_streams(3))
+    assert_array_equal(tagger.class_long_lengths_, [0, 20])
+    rng = np.random.RandomState(5)
+    held = rng.normal(0, 0.2, (140, 4)).astype(np.float32)
+    held[30:110, 0] += 1.5
+    gesture = _streams(1, seed=6)[0][0]
+    plain = tagger.predict([held, gesture])
+    assert plain[0][40:100].mean() > 0.9  # one long run of class 1
+    tagger.set_params(max_duration=2.0)
+    held_out, kept = tagger.predict([held, gesture])
+    assert not held_out.any()
+    assert_array_equal(kept, plain[1])
+    assert (kept[22:38] == 1).all()
+
+
 def test_min_confidence_drops_the_unsure_runs_only():
     tagger = TRAINED["sequence"]().fit(*_streams(3))
     x_test = _streams(2, seed=5)[0]
@@ -320,6 +339,16 @@ def test_min_confidence_drops_the_unsure_runs_only():
     assert_array_equal(np.sort(kept[:, 3]), np.sort(conf[conf >= floor]))
     tagger.set_params(min_confidence=1.0)
     assert not any(p.any() for p in tagger.predict(x_test))
+
+
+def test_max_duration_on_a_model_fitted_without_long_lengths_says_so():
+    tagger = TAGGERS["sequence"](random_state=0).fit(*_streams())
+    del tagger.class_long_lengths_  # a model saved before the attribute existed
+    tagger.set_params(max_duration=2.0)
+    with pytest.raises(ValueError, match="class_long_lengths_.*refit it"):
+        tagger.predict(_streams(1)[0])
+    tagger.set_params(max_duration=None)
+    tagger.predict(_streams(1)[0])
 
 
 def test_min_duration_on_a_model_fitted_without_lengths_says_so():

@@ -26,6 +26,7 @@ from sklearn.utils.validation import check_is_fitted
 from skgesture._nn._training import IGNORE_INDEX, torch_threads
 from skgesture._stream import DEFAULT_MAX_PERIOD, StreamableMixin
 from skgesture._taggers._decoding import (
+    LONG_QUANTILE,
     SMOOTHINGS,
     ViterbiRule,
     class_lengths,
@@ -59,6 +60,7 @@ _DECODING_CONSTRAINTS = {
     "max_gap": [Interval(Integral, 0, None, closed="left")],
     "min_confidence": [Interval(Real, 0, 1, closed="both")],
     "min_duration": [Interval(Real, 0, None, closed="left")],
+    "max_duration": [None, Interval(Real, 0, None, closed="neither")],
     "viterbi_penalty": [None, Interval(Real, 0, None, closed="left")],
     "viterbi_duration": [Interval(Real, 0, None, closed="left")],
     "viterbi_lag": [Interval(Integral, 0, None, closed="left")],
@@ -77,13 +79,15 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
     ``fit(X, y_idx)`` trains the network; cached by ``memory``),
     ``_adopt(fitted)`` (copies its fitted state) and ``_raw_proba(X)``, and
     have the parameters ``smooth_span``, ``smoothing``, ``min_run``,
-    ``max_gap``, ``min_confidence``, ``min_duration``, ``memory`` and
+    ``max_gap``, ``min_confidence``, ``min_duration``, ``max_duration``,
+    ``memory`` and
     ``n_threads`` (or class attributes of these names, for rules a tagger
     fixes).
 
-    ``fit`` stores ``class_lengths_``, the 10th percentile of every class's
-    training run lengths (its short gesture), so that ``min_duration`` (a
-    fraction of it) changes without retraining.
+    ``fit`` stores ``class_lengths_`` and ``class_long_lengths_``, the 10th
+    and 90th percentiles of every class's training run lengths (its short and
+    its long gesture), so that ``min_duration`` and ``max_duration`` (fractions
+    of them) change without retraining.
 
     Untracked rows (those of :func:`untracked_rows`: the masked rows of a
     ``numpy.ma.MaskedArray``, the all-zero rows of a plain array) are rest by
@@ -112,6 +116,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                 "labels 1..K as well as rest"
             )
         self.class_lengths_ = class_lengths(y, classes)
+        self.class_long_lengths_ = class_lengths(y, classes, quantile=LONG_QUANTILE)
         y_idx = np.split(y_idx.astype(np.int64), np.cumsum([len(v) for v in y])[:-1])
         if ignore_untracked:
             for lab, rows in zip(y_idx, _untracked(X, data)):
@@ -259,12 +264,29 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                     getattr(self, "viterbi_lag", 0),
                 )
         return {
+            **self._long_rule(),
             "min_run": self.min_run,
             "max_gap": self.max_gap,
             "min_confidence": float(getattr(self, "min_confidence", 0.0)),
             "min_lengths": lengths,
             "viterbi": viterbi,
         }
+
+    def _long_rule(self):
+        """``max_lengths`` of the run rules: ``max_duration`` times the long
+        gesture of every class (no limit for a class without one), or None."""
+        ratio = getattr(self, "max_duration", None)
+        if ratio is None:
+            return {"max_lengths": None}
+        fitted = getattr(self, "class_long_lengths_", None)
+        if fitted is None:  # a model fitted before max_duration existed
+            raise ValueError(
+                f"max_duration={ratio} needs class_long_lengths_, which this "
+                f"{type(self).__name__} was fitted without: refit it, or set "
+                "max_duration=None"
+            )
+        fitted = np.asarray(fitted, dtype=float)
+        return {"max_lengths": np.where(fitted > 0, ratio * fitted, np.inf)}
 
     def _decode(self, proba, untracked=None):
         return decode(

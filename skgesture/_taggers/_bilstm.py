@@ -371,6 +371,8 @@ class BiLSTMTagger(_BaseTagger):
         The 10th percentile of every class's run lengths in ``fit``, in
         frames (0 for rest); Method C keeps every run of ``min_run`` frames
         or more, whatever its class's length.
+    class_long_lengths_ : ndarray of shape (n_classes,)
+        The 90th percentile of the same lengths, unused by Method C.
     net_ : skorch.NeuralNet
         The trained network; ``net_.history`` holds the losses and learning
         rates (``"event_lr"``) of every epoch.
@@ -546,7 +548,8 @@ class BiLSTMTagger(_BaseTagger):
     smoothing = "loess"  # MATLAB-style loess of span smooth_span
     max_gap = 0  # no merging of split runs
     min_confidence = 0.0  # and the paper's rules only: no run rejected for
-    min_duration = 0.0  # its confidence or its class's length,
+    min_duration = 0.0  # its confidence or its class's length (short
+    max_duration = None  # or long),
     viterbi_penalty = None  # and the arg-max of every frame
 
     @_fit_context(prefer_skip_nested_validation=True)

@@ -112,6 +112,7 @@ def fill_short_gaps(labels, max_gap, *, rest=0):
 
 
 LENGTH_QUANTILE = 10  # percentile of a class's training lengths: its "short" gesture
+LONG_QUANTILE = 90  # and its "long" gesture
 
 
 def class_lengths(y, classes, *, quantile=LENGTH_QUANTILE):
@@ -157,13 +158,17 @@ def class_lengths(y, classes, *, quantile=LENGTH_QUANTILE):
     )
 
 
-def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
-    """Set to rest the gesture runs too short for their class or too unsure.
+def reject_runs(
+    labels, raw, classes, *, min_confidence=0.0, min_lengths=None, max_lengths=None
+):
+    """Set to rest the gesture runs too short or too long for their class, or
+    too unsure.
 
     The last rules of the decoding, applied to every run on its own (so a
     stream decides a run as soon as it ends): a run of class ``c`` shorter
-    than ``min_lengths[c]`` frames, or whose mean raw probability of ``c`` is
-    below ``min_confidence``, becomes rest.
+    than ``min_lengths[c]`` frames, longer than ``max_lengths[c]`` frames, or
+    whose mean raw probability of ``c`` is below ``min_confidence``, becomes
+    rest.
 
     Parameters
     ----------
@@ -178,6 +183,9 @@ def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
         :func:`segments_with_confidence`).
     min_lengths : ndarray of shape (n_classes,) or None, default=None
         Shortest run kept per class, in frames; None keeps every length.
+    max_lengths : ndarray of shape (n_classes,) or None, default=None
+        Longest run kept per class, in frames (``inf``: no limit); None
+        keeps every length.
 
     Returns
     -------
@@ -192,11 +200,13 @@ def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
     >>> raw = np.eye(3)[lab] * 0.9 + 0.1 / 3
     >>> reject_runs(lab, raw, np.arange(3), min_lengths=np.array([0, 3, 3])).tolist()
     [0, 0, 0, 0, 2, 2, 2, 0]
+    >>> reject_runs(lab, raw, np.arange(3), max_lengths=np.array([0, 9, 2])).tolist()
+    [0, 1, 1, 0, 0, 0, 0, 0]
     >>> reject_runs(lab, raw, np.arange(3), min_confidence=0.95).tolist()
     [0, 0, 0, 0, 0, 0, 0, 0]
     """
     labels = np.array(labels, copy=True)
-    if min_confidence <= 0 and min_lengths is None:
+    if min_confidence <= 0 and min_lengths is None and max_lengths is None:
         return labels
     classes = np.asarray(classes)
     starts, ends, values = runs(labels)
@@ -205,7 +215,12 @@ def reject_runs(labels, raw, classes, *, min_confidence=0.0, min_lengths=None):
             continue
         k = int(np.searchsorted(classes, v))
         too_short = min_lengths is not None and e - s < min_lengths[k]
-        if too_short or (min_confidence > 0 and raw[s:e, k].mean() < min_confidence):
+        too_long = max_lengths is not None and e - s > max_lengths[k]
+        if (
+            too_short
+            or too_long
+            or (min_confidence > 0 and raw[s:e, k].mean() < min_confidence)
+        ):
             labels[s:e] = 0
     return labels
 
@@ -246,6 +261,7 @@ def apply_run_rules(
     max_gap=0,
     min_confidence=0.0,
     min_lengths=None,
+    max_lengths=None,
 ):
     """The rules of :func:`decode` that follow the path, on its labels.
 
@@ -272,6 +288,7 @@ def apply_run_rules(
         classes,
         min_confidence=min_confidence,
         min_lengths=min_lengths,
+        max_lengths=max_lengths,
     )
 
 
@@ -309,6 +326,7 @@ def decode(
     untracked=None,
     min_confidence=0.0,
     min_lengths=None,
+    max_lengths=None,
     viterbi=None,
     raw=None,
 ):
@@ -336,6 +354,8 @@ def decode(
         (:func:`reject_runs`), after the ``min_run`` filter.
     min_lengths : ndarray of shape (n_classes,) or None, default=None
         Shortest run kept per class (:func:`reject_runs`).
+    max_lengths : ndarray of shape (n_classes,) or None, default=None
+        Longest run kept per class (:func:`reject_runs`).
     viterbi : ViterbiRule or None, default=None
         The labels before the rules: None, the arg-max of every frame; a
         rule, the duration-aware Viterbi path decided at its lag
@@ -370,6 +390,7 @@ def decode(
         max_gap=max_gap,
         min_confidence=min_confidence,
         min_lengths=min_lengths,
+        max_lengths=max_lengths,
     )
 
 
@@ -466,7 +487,7 @@ class LabelRuns:
         there (bounds memory on a stream that never rests; offline has no
         such cap). None: no cap.
     min_confidence : float, default=0.0
-    min_lengths : ndarray of shape (n_classes,) or None, default=None
+    min_lengths, max_lengths : ndarray of shape (n_classes,) or None, default=None
         The run rules of :func:`reject_runs`: they judge each run on its own,
         so they move no cut.
     viterbi : ViterbiRule or None, default=None
@@ -498,6 +519,7 @@ class LabelRuns:
         max_run=None,
         min_confidence=0.0,
         min_lengths=None,
+        max_lengths=None,
         viterbi=None,
     ):
         self.classes = np.asarray(classes)
@@ -505,6 +527,7 @@ class LabelRuns:
         self.max_gap = int(max_gap)
         self.min_confidence = float(min_confidence)
         self.min_lengths = min_lengths
+        self.max_lengths = max_lengths
         self.viterbi = viterbi
         self.path = None if viterbi is None else viterbi.path()
         self.lag = 0 if viterbi is None else viterbi.lag
@@ -592,6 +615,7 @@ class LabelRuns:
                 max_gap=self.max_gap,
                 min_confidence=self.min_confidence,
                 min_lengths=self.min_lengths,
+                max_lengths=self.max_lengths,
             )
             for cls, s, e, conf in segments_with_confidence(
                 labels, raw, self.classes

@@ -123,6 +123,12 @@ class SequenceTagger(_BaseTagger):
         gesture (``class_lengths_``: the 10th percentile of its run lengths
         in ``fit``) become rest. Everyday motion that the network takes for a
         gesture is mostly briefer than the gesture.
+    max_duration : float or None, default=None
+        Gesture runs longer than this multiple of their class's long gesture
+        (``class_long_lengths_``: the 90th percentile of its run lengths in
+        ``fit``) become rest: a "gesture" that goes on for several times its
+        usual length is walking, carrying or another activity. None: no
+        limit.
     viterbi_penalty : float or None, default=None
         None: the labels are the arg-max of every frame. A float: they are
         the duration-aware Viterbi path (a gesture lasts at least
@@ -175,6 +181,9 @@ class SequenceTagger(_BaseTagger):
     class_lengths_ : ndarray of shape (n_classes,)
         The 10th percentile of every class's run lengths in ``fit``, in
         frames (0 for rest), the unit of ``min_duration``.
+    class_long_lengths_ : ndarray of shape (n_classes,)
+        The 90th percentile of every class's run lengths in ``fit``, in
+        frames (0 for rest), the unit of ``max_duration``.
     net_ : skorch.NeuralNet
         The trained network (``net_.history`` holds the losses).
     mean_ : ndarray of shape (n_features,)
@@ -295,6 +304,7 @@ class SequenceTagger(_BaseTagger):
         max_gap=0,
         min_confidence=0.0,
         min_duration=0.0,
+        max_duration=None,
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
@@ -333,6 +343,7 @@ class SequenceTagger(_BaseTagger):
         self.max_gap = max_gap
         self.min_confidence = min_confidence
         self.min_duration = min_duration
+        self.max_duration = max_duration
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag

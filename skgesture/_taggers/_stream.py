@@ -250,7 +250,7 @@ class TrailingWindowStream:
     owner : str, default="smooth_span"
         Parameter name for error messages.
     **run_rules : dict
-        ``min_confidence``, ``min_lengths`` and ``viterbi`` of
+        ``min_confidence``, ``min_lengths``, ``max_lengths`` and ``viterbi`` of
         :class:`LabelRuns`.
 
     Examples

@@ -50,6 +50,12 @@ class VotingTagger(_BaseTagger):
         gesture (``class_lengths_``: the 10th percentile of its run lengths
         in ``fit``) become rest. Everyday motion that the network takes for a
         gesture is mostly briefer than the gesture.
+    max_duration : float or None, default=None
+        Gesture runs longer than this multiple of their class's long gesture
+        (``class_long_lengths_``: the 90th percentile of its run lengths in
+        ``fit``) become rest: a "gesture" that goes on for several times its
+        usual length is walking, carrying or another activity. None: no
+        limit.
     viterbi_penalty : float or None, default=None
         None: the labels are the arg-max of every frame. A float: they are
         the duration-aware Viterbi path (a gesture lasts at least
@@ -88,6 +94,9 @@ class VotingTagger(_BaseTagger):
     class_lengths_ : ndarray of shape (n_classes,)
         The 10th percentile of every class's run lengths in ``fit``, in
         frames (0 for rest), the unit of ``min_duration``.
+    class_long_lengths_ : ndarray of shape (n_classes,)
+        The 90th percentile of every class's run lengths in ``fit``, in
+        frames (0 for rest), the unit of ``max_duration``.
     n_features_in_ : int
         Number of features per frame.
     frame_shape_in_ : tuple of int
@@ -131,6 +140,7 @@ class VotingTagger(_BaseTagger):
         max_gap=0,
         min_confidence=0.0,
         min_duration=0.0,
+        max_duration=None,
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
@@ -147,6 +157,7 @@ class VotingTagger(_BaseTagger):
         self.max_gap = max_gap
         self.min_confidence = min_confidence
         self.min_duration = min_duration
+        self.max_duration = max_duration
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag
