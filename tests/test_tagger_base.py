@@ -341,21 +341,20 @@ def test_min_confidence_drops_the_unsure_runs_only():
     assert not any(p.any() for p in tagger.predict(x_test))
 
 
-def test_max_duration_on_a_model_fitted_without_long_lengths_says_so():
+@pytest.mark.parametrize(
+    "attribute, rule, off",
+    [
+        ("class_lengths_", {"min_duration": 0.3}, {"min_duration": 0.0}),
+        ("class_long_lengths_", {"max_duration": 2.0}, {"max_duration": None}),
+    ],
+)
+def test_a_length_rule_on_a_model_fitted_without_its_lengths_says_so(
+    attribute, rule, off
+):
     tagger = TAGGERS["sequence"](random_state=0).fit(*_streams())
-    del tagger.class_long_lengths_  # a model saved before the attribute existed
-    tagger.set_params(max_duration=2.0)
-    with pytest.raises(ValueError, match="class_long_lengths_.*refit it"):
+    delattr(tagger, attribute)  # a model saved before the attribute existed
+    tagger.set_params(**rule)
+    with pytest.raises(ValueError, match=f"{attribute}.*refit it"):
         tagger.predict(_streams(1)[0])
-    tagger.set_params(max_duration=None)
-    tagger.predict(_streams(1)[0])
-
-
-def test_min_duration_on_a_model_fitted_without_lengths_says_so():
-    tagger = TAGGERS["sequence"](random_state=0).fit(*_streams())
-    del tagger.class_lengths_  # a model saved before the attribute existed
-    tagger.set_params(min_duration=0.3)
-    with pytest.raises(ValueError, match="class_lengths_.*refit it"):
-        tagger.predict(_streams(1)[0])
-    tagger.set_params(min_duration=0.0)
+    tagger.set_params(**off)
     tagger.predict(_streams(1)[0])
