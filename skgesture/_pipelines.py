@@ -26,7 +26,8 @@ __all__ = [
 
 # make_recommended's defaults (docs/choosing.md, docs/safety.md)
 LOOKAHEAD = 8  # frames of future the tagger reads
-MIN_DURATION = 0.3  # runs shorter than this fraction of their class's short gesture
+MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short gesture
+MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
 VITERBI_PENALTY = 5.0  # the duration-aware path: nats to enter a gesture
 BACKGROUND_SEQUENCES = 12  # synthetic negatives made at every fit (background=)
 
@@ -282,7 +283,8 @@ def make_recommended(
     memory : None, str or joblib.Memory, default=None
         Cache of the trained network, so that the decoding parameters
         (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``,
-        ``tagger__min_confidence``, ``tagger__min_duration``) can be searched
+        ``tagger__min_confidence``, ``tagger__min_duration``,
+        ``tagger__max_duration``, ``tagger__viterbi_penalty``) can be searched
         without retraining.
     random_state : int, RandomState instance or None, default=None
         Seeds the network, the crops, the augmentation and the background.
@@ -304,8 +306,9 @@ def make_recommended(
     nats, a gesture lasts at least 0.7 of its class's short gesture, the 10th
     percentile of the class's lengths in ``fit``), decided 6 frames after
     each frame (``tagger__viterbi_lag``), offline as live. Then a run shorter
-    than 0.3 of its class's short gesture (``tagger__min_duration``) is
-    rest. A confidence floor (``tagger__min_confidence``) is left at 0: the
+    than 0.5 of its class's short gesture (``tagger__min_duration``) or
+    longer than 2.5 times its long gesture (``tagger__max_duration``; the
+    90th percentile) is rest. A confidence floor (``tagger__min_confidence``) is left at 0: the
     floor that suits one dataset costs another much (docs/safety.md,
     "Choosing the confidence floor"). The rules judge a run once it has
     ended, so the model still streams exactly.
@@ -348,6 +351,7 @@ def make_recommended(
         augment=augment,
         lookahead=lookahead,
         min_duration=MIN_DURATION,
+        max_duration=MAX_DURATION,
         viterbi_penalty=VITERBI_PENALTY,
         fit_threads="all",
         memory=memory,
