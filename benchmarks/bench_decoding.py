@@ -56,7 +56,8 @@ Protocol
   (ties: the larger worst change). The default qualifies, so there always is
   one; it is printed under the table.
 * **Figure** (``decoding.png``, ``decoding_quick.png`` in quick mode): false
-  events per minute against the worst change, one point per setting.
+  events per minute against the worst change, one point per setting; the rows
+  and notes beside it as ``decoding.json`` (``decoding_quick.json``).
 
 Every fit's probabilities are cached as a compressed ``.npz`` (float32: the
 network's softmax is float32, so nothing is lost) under
@@ -98,6 +99,7 @@ import json
 import os
 import platform
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -165,8 +167,8 @@ QUICK_GRID = {
     "smooth_span": (1, 5),
     "min_run": (1,),
     "min_confidence": (0.0, 0.5, 0.9),
-    "min_duration": (0.0, 0.3),
-    "max_duration": (None, 2.0),
+    "min_duration": (0.0, 0.5),
+    "max_duration": (None, 2.5),
     "viterbi_penalty": (None, 5.0),
 }
 TOLERANCE = 0.005  # the chosen setting loses at most this Jaccard anywhere
@@ -668,7 +670,10 @@ def run(
     if background is not None:
         NOTES.append(f"every fit: make_recommended(background={background!r})")
     stem = "decoding" + ("" if background is None else f"_bg{background}")
-    figure = plot_settings(rows, out_dir / f"{stem}{'_quick' if quick else ''}.png")
+    stem += "_quick" if quick else ""
+    figure = plot_settings(rows, out_dir / f"{stem}.png")
+    with open(out_dir / f"{stem}.json", "w") as fh:  # the rows, to re-plot or quote
+        json.dump({"rows": rows, "notes": NOTES}, fh, indent=1)
     rows.append({"table": "figure", "path": str(figure)})
     return rows
 
@@ -725,6 +730,7 @@ def plot_settings(rows, path):
     ax.scatter(x, y, s=18, color="C0", label="a setting")
     for r, xi, yi in zip(rows, x, y):
         short = ", ".join(f"{p} {fmt_value(r['setting'][p])}" for p in PARAMS)
+        short = textwrap.fill(short, 60, subsequent_indent="  ")
         if r["default"]:
             label = f"current default: {short}"
             ax.plot(xi, yi, "s", ms=10, mfc="none", color="C3", label=label)
@@ -737,7 +743,7 @@ def plot_settings(rows, path):
     ax.set_xlabel("worst-case Jaccard change from the current default")
     ax.set_ylabel("false gesture events per minute")
     ax.set_title("decoding settings (dotted: the tolerance)")
-    ax.legend(fontsize=7, loc="upper left")
+    ax.legend(fontsize=7, loc="lower center")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)

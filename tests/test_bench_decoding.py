@@ -12,6 +12,7 @@ cached probabilities without fitting again.
 # SPDX-License-Identifier: BSD-3-Clause
 
 import itertools
+import json
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -201,6 +202,11 @@ def test_figure_and_tables(quick_run):
     path = Path(figures[0]["path"])
     assert path.parent == out and path.name == "decoding_quick.png"
     assert path.is_file() and path.stat().st_size > 0
+    saved = json.loads(path.with_suffix(".json").read_text())  # the rows beside it
+    assert [r["setting"] for r in saved["rows"]] == [
+        r["setting"] for r in _settings(rows)
+    ]
+    assert any(n.startswith("chosen") for n in saved["notes"])
     text = bench_decoding.format_tables(rows, "decoding")
     lines = [line for line in text.splitlines() if line.startswith("| ")]
     assert len(lines) == 1 + len(_settings(rows))  # the header and a row each
