@@ -151,6 +151,11 @@ def test_the_fixtures_are_complete_and_from_0_1(stored):
 # runs in numpy (skgesture._nn._fast.MLPProba), equal to 0.1's torch pass to
 # float32 rounding; everything decided from it (labels, segments) is identical.
 FLOAT32_ROUNDING = {"method_b"}
+# The recommended model's stream runs its convolutions on trailing windows, whose
+# float32 sums the CPU's kernels may order otherwise than the whole-sequence pass
+# of 0.1: its events are identical, their confidences equal to float32 rounding
+# (exact on the machine that wrote the fixtures, 6e-8 apart on an AMD EPYC).
+STREAM_ROUNDING = {"recommended"}
 # the columns of those outputs that are probabilities (segments and events:
 # class, start, end, confidence[, emitted_at]; the segmenter's decision: all)
 ROUNDED_COLUMNS = {"predict_segments": [3], "stream": [3], "segmenter_decision": [0]}
@@ -170,7 +175,10 @@ def test_legacy_model_gives_identical_outputs(name, kind, stored):
         for i, (a, b) in enumerate(zip(got[quantity], want)):
             where = f"{name}.{kind}: {quantity} of sequence {i} differs from 0.1's"
             assert a.shape == b.shape, where
-            if name in FLOAT32_ROUNDING and quantity in ROUNDED_COLUMNS:
+            rounded_here = name in FLOAT32_ROUNDING or (
+                name in STREAM_ROUNDING and quantity == "stream"
+            )
+            if rounded_here and quantity in ROUNDED_COLUMNS:
                 # labels and frames exactly; probabilities and confidences to
                 # float32 rounding
                 rounded = ROUNDED_COLUMNS[quantity]
