@@ -893,6 +893,16 @@ def test_stream_ctrl_c_flushes_and_prints_the_summary(
     """Ctrl-C ends a live stream cleanly, status 0: the frames pushed so far
     are flushed (a Ctrl-C inside a push waits for the push to finish), their
     events printed, then the summary."""
+    # Python's own Ctrl-C handler, as in a terminal: a suite started in the
+    # background (`cmd &`, nohup) inherits SIGINT ignored, which the CLI honours
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _ctrl_c_case(model_b, held_out, capsys, monkeypatch, where)
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def _ctrl_c_case(model_b, held_out, capsys, monkeypatch, where):
     from skgesture.streaming import StreamingRecognizer
 
     frames, k = held_out.X[0], 900
