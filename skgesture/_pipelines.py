@@ -308,8 +308,9 @@ def make_recommended(
     each frame (``tagger__viterbi_lag``), offline as live. Then a run shorter
     than 0.5 of its class's short gesture (``tagger__min_duration``) or
     longer than 2.5 times its long gesture (``tagger__max_duration``; the
-    90th percentile) is rest. A confidence floor (``tagger__min_confidence``) is left at 0: the
-    floor that suits one dataset costs another much (docs/safety.md,
+    90th percentile) is rest. A confidence floor
+    (``tagger__min_confidence``) is left at 0: the floor that suits one
+    dataset costs another much (docs/safety.md,
     "Choosing the confidence floor"). The rules judge a run once it has
     ended, so the model still streams exactly.
 
