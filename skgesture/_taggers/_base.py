@@ -80,9 +80,8 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
     ``_adopt(fitted)`` (copies its fitted state) and ``_raw_proba(X)``, and
     have the parameters ``smooth_span``, ``smoothing``, ``min_run``,
     ``max_gap``, ``min_confidence``, ``min_duration``, ``max_duration``,
-    ``memory`` and
-    ``n_threads`` (or class attributes of these names, for rules a tagger
-    fixes).
+    ``memory`` and ``n_threads`` (or class attributes of these names, for
+    rules a tagger fixes).
 
     ``fit`` stores ``class_lengths_`` and ``class_long_lengths_``, the 10th
     and 90th percentiles of every class's training run lengths (its short and
@@ -246,15 +245,11 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         penalty = getattr(self, "viterbi_penalty", None)
         lengths = viterbi = None
         if ratio > 0 or penalty is not None:
-            fitted = getattr(self, "class_lengths_", None)
-            if fitted is None:  # a model fitted before min_duration existed
-                name = f"min_duration={ratio}" if ratio > 0 else "viterbi_penalty"
-                raise ValueError(
-                    f"{name} needs class_lengths_, which this "
-                    f"{type(self).__name__} was fitted without: refit it, or set "
-                    "min_duration=0 and viterbi_penalty=None"
-                )
-            fitted = np.asarray(fitted, dtype=float)
+            fitted = self._fitted_lengths(
+                "class_lengths_",
+                f"min_duration={ratio}" if ratio > 0 else "viterbi_penalty",
+                "min_duration=0 and viterbi_penalty=None",
+            )
             if ratio > 0:
                 lengths = ratio * fitted
             if penalty is not None:
@@ -263,30 +258,32 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                     penalty,
                     getattr(self, "viterbi_lag", 0),
                 )
+        longest = getattr(self, "max_duration", None)
+        max_lengths = None
+        if longest is not None:  # no limit for a class without a run
+            fitted = self._fitted_lengths(
+                "class_long_lengths_", f"max_duration={longest}", "max_duration=None"
+            )
+            max_lengths = np.where(fitted > 0, longest * fitted, np.inf)
         return {
-            **self._long_rule(),
             "min_run": self.min_run,
             "max_gap": self.max_gap,
             "min_confidence": float(getattr(self, "min_confidence", 0.0)),
             "min_lengths": lengths,
+            "max_lengths": max_lengths,
             "viterbi": viterbi,
         }
 
-    def _long_rule(self):
-        """``max_lengths`` of the run rules: ``max_duration`` times the long
-        gesture of every class (no limit for a class without one), or None."""
-        ratio = getattr(self, "max_duration", None)
-        if ratio is None:
-            return {"max_lengths": None}
-        fitted = getattr(self, "class_long_lengths_", None)
-        if fitted is None:  # a model fitted before max_duration existed
+    def _fitted_lengths(self, attribute, rule, off):
+        """The fitted per-class lengths ``attribute`` that ``rule`` reads; a
+        clear error for a model fitted before the attribute existed."""
+        fitted = getattr(self, attribute, None)
+        if fitted is None:
             raise ValueError(
-                f"max_duration={ratio} needs class_long_lengths_, which this "
-                f"{type(self).__name__} was fitted without: refit it, or set "
-                "max_duration=None"
+                f"{rule} needs {attribute}, which this {type(self).__name__} "
+                f"was fitted without: refit it, or set {off}"
             )
-        fitted = np.asarray(fitted, dtype=float)
-        return {"max_lengths": np.where(fitted > 0, ratio * fitted, np.inf)}
+        return np.asarray(fitted, dtype=float)
 
     def _decode(self, proba, untracked=None):
         return decode(
