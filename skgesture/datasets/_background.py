@@ -10,6 +10,8 @@ out, so the negatives never teach the model to reject its own gestures
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from numbers import Integral, Real
+
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from sklearn.base import BaseEstimator
@@ -88,6 +90,20 @@ class _Vocabulary:
     def resembles(self, x):
         d = np.linalg.norm(self.templates - _template(x), axis=1)
         return bool(np.any(d <= self.spread))
+
+
+def _n_background(n_sequences, n_recordings):
+    """The number of sequences ``n_sequences`` asks for: an int as it is, a
+    float in (0, 1) as that share of ``n_recordings`` (at least one)."""
+    if isinstance(n_sequences, Real) and not isinstance(n_sequences, (bool, Integral)):
+        share = float(n_sequences)
+        if not 0.0 < share < 1.0:
+            raise ValueError(
+                f"n_sequences must be an int >= 1 or a share of the recordings "
+                f"in (0, 1), got {n_sequences!r}"
+            )
+        return max(1, int(round(share * n_recordings)))
+    return _check_int(n_sequences, "n_sequences", 1)
 
 
 def _check_kinds(kinds):
@@ -206,8 +222,11 @@ def make_background(
         ``numpy.ma.MaskedArray``) are never used.
     y : list of array-like of shape (n_frames_i,)
         Their per-frame labels, 0 = rest; at least one gesture.
-    n_sequences : int, default=10
-        Number of sequences made.
+    n_sequences : int or float, default=10
+        Number of sequences made. A float in (0, 1) is a share of the
+        recordings: ``round(n_sequences * len(X))`` sequences, at least one,
+        so that the negatives are the same share of the training sequences
+        (and of the crops a tagger draws from them) whatever the data size.
     n_frames : int or None, default=None
         Length of every sequence; None: the median length of the recordings,
         at least four median gestures.
@@ -304,7 +323,7 @@ def make_background(
                 f"X[{i}] has frames of shape {x.shape[1:]}, but X[0] has "
                 f"{frame_shape}: all recordings must agree"
             )
-    n_sequences = _check_int(n_sequences, "n_sequences", 1)
+    n_sequences = _n_background(n_sequences, len(X))
     if n_frames is not None:
         n_frames = _check_int(n_frames, "n_frames", 2)
     kinds = _check_kinds(kinds)
@@ -514,8 +533,9 @@ class SyntheticBackground(BaseEstimator):
 
     Parameters
     ----------
-    n_sequences : int, default=12
-        Sequences made at every ``fit``.
+    n_sequences : int or float, default=12
+        Sequences made at every ``fit``; a float in (0, 1) is that share of
+        the recordings ``fit`` is given (see :func:`make_background`).
     n_frames : int or None, default=None
         Length of every sequence (see :func:`make_background`).
     kinds : sequence of str or None, default=None
