@@ -122,6 +122,7 @@ from bench_oov import (  # noqa: E402
     quick_data,
 )
 from joblib import Parallel, delayed  # noqa: E402
+from sklearn.base import clone  # noqa: E402
 
 import skgesture  # noqa: E402
 from skgesture._rate import (  # noqa: E402
@@ -131,7 +132,11 @@ from skgesture._rate import (  # noqa: E402
     segments_back,
 )
 from skgesture._taggers._decoding import segments_with_confidence  # noqa: E402
-from skgesture.datasets import make_gesture_streams  # noqa: E402
+from skgesture.datasets import (  # noqa: E402
+    SyntheticBackground,
+    make_background,
+    make_gesture_streams,
+)
 from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -250,6 +255,31 @@ BACKGROUNDS = {
 }
 
 
+class PossibleKinds(SyntheticBackground):
+    """``SyntheticBackground`` whose ``kinds`` are the most it asks for: of
+    them, those the recordings of the fit can give (``make_background``
+    refuses a kind it cannot make; ``kinds=None`` makes every possible one)."""
+
+    def make(self, X, y):
+        kinds = self.kinds
+        if kinds is not None:
+            kinds = [k for k in kinds if _can_make(X, y, k)]
+        return clone(self).set_params(kinds=kinds or None).make_all(X, y)
+
+    def make_all(self, X, y):
+        return super().make(X, y)
+
+
+def _can_make(X, y, kind):
+    try:
+        make_background(X, y, n_sequences=1, n_frames=2, kinds=(kind,))
+    except ValueError as exc:
+        if "cannot give" in str(exc):
+            return False
+        raise
+    return True
+
+
 def background_of(name, seed):
     """The background object of the variant ``name`` (``BACKGROUNDS``)."""
     if name not in BACKGROUNDS:
@@ -257,7 +287,8 @@ def background_of(name, seed):
     if BACKGROUNDS[name] is None:
         return None
     made = skgesture.make_recommended(background="synthetic", random_state=seed)
-    return made.background.set_params(**BACKGROUNDS[name])
+    params = made.background.get_params()
+    return PossibleKinds(**{**params, **BACKGROUNDS[name]})
 
 
 def build_model(joints, seed, quick, background=None, fit_threads=None):
@@ -619,8 +650,9 @@ def run(
     datasets : sequence of str or None, default=None
         Names of ``JOINTS`` (quick: of ``QUICK_DATASETS``); None: all.
     grid : dict or None, default=None
-        Values of every parameter of ``PARAMS``; None: ``GRID`` (quick:
-        ``QUICK_GRID``). The cache does not depend on it.
+        Values of every parameter of ``PARAMS`` (a parameter left out keeps
+        the default's value, so ``{}`` decodes the default alone); None:
+        ``GRID`` (quick: ``QUICK_GRID``). The cache does not depend on it.
     out_dir : path-like or None, default=None
         Folder of the figure and of the cache (``<out_dir>/decoding``); None:
         ``$SKG_BENCH_DECODING_DIR`` or ``bench_results/``.
@@ -657,7 +689,9 @@ def run(
     folds_of, negatives = _datasets(quick, datasets)
     if not folds_of:
         raise ValueError("no dataset to run on (none found)")
-    settings, default = settings_of(grid or (QUICK_GRID if quick else GRID))
+    settings, default = settings_of(
+        grid if grid is not None else (QUICK_GRID if quick else GRID)
+    )
     cache_dir = out_dir / "decoding"
     fit_threads = None if n_jobs == 1 else max(1, (os.cpu_count() or 1) // n_jobs)
     plan, missing = [], []  # every cell, and the ones to fit
@@ -857,6 +891,11 @@ def main(argv=None):
         help="fit this background variant instead of the model's own (BACKGROUNDS)",
     )
     parser.add_argument(
+        "--default-only",
+        action="store_true",
+        help="decode with the current default alone (to compare fits, not decodings)",
+    )
+    parser.add_argument(
         "--jobs", type=int, default=1, help="fits at once (worker processes)"
     )
     args = parser.parse_args(argv)
@@ -868,6 +907,7 @@ def main(argv=None):
             if args.datasets
             else None
         ),
+        grid={} if args.default_only else None,
         out_dir=args.out_dir,
         background=args.background,
         n_jobs=args.jobs,

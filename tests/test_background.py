@@ -173,6 +173,9 @@ def test_masked_rows_are_untracked_frames_and_never_used():
     "kwargs, match",
     [
         ({"n_sequences": 0}, "n_sequences must be >= 1"),
+        ({"n_sequences": 1.5}, r"a share of the recordings in \(0, 1\), got 1.5"),
+        ({"n_sequences": 0.0}, r"a share of the recordings in \(0, 1\), got 0.0"),
+        ({"n_sequences": float("nan")}, "a share of the recordings"),
         ({"n_frames": 1}, "n_frames must be >= 2"),
         ({"kinds": ["noise"]}, "unknown background kind 'noise'"),
         ({"kinds": []}, "kinds is empty"),
@@ -255,6 +258,21 @@ def test_background_none_adds_nothing_and_its_parameters_are_searchable(data):
     pipe = _pipeline(SyntheticBackground()).set_params(background__n_sequences=2)
     assert clone(pipe).background.n_sequences == 2
     assert len(pipe.fit(data.X, data.y)[-1].seen[0]) == len(data.X) + 2
+
+
+def test_a_share_of_the_recordings_makes_that_share_of_sequences(data):
+    """A float ``n_sequences`` keeps the negatives the same share of the
+    training sequences whatever the data size, never fewer than one."""
+    from skgesture.datasets import SyntheticBackground
+
+    X, y = _ramps(20)
+    assert len(make_background(X, y, n_sequences=0.1, random_state=0).X) == 2
+    assert len(make_background(X, y, n_sequences=0.25, random_state=0).X) == 5
+    assert len(make_background(X[:3], y[:3], n_sequences=0.1, random_state=0).X) == 1
+    bg = SyntheticBackground(n_sequences=0.5, random_state=0)
+    pipe = _pipeline(bg).fit(data.X, data.y)
+    n = len(data.X)
+    assert len(pipe[-1].seen[0]) == n + max(1, round(0.5 * n))
 
 
 def test_a_background_without_make_or_labels_is_refused(data):

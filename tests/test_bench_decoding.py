@@ -26,9 +26,11 @@ pytest.importorskip("torch")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 import bench_decoding  # noqa: E402
+from test_background import _ramps  # noqa: E402
 
 from skgesture import GesturePipeline  # noqa: E402
 from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
+from skgesture.utils._segments import labels_to_segments  # noqa: E402
 
 KEYS = {
     "table",
@@ -260,3 +262,51 @@ def test_background_synthetic_fits_with_negatives_in_cells_of_its_own(tmp_path):
     assert Path(figure).name == "decoding_bgsynthetic_quick.png"
     assert Path(figure).exists()
     assert any("background='synthetic'" in n for n in bench_decoding.NOTES)
+
+
+def test_background_variants_and_parallel_fits(tmp_path):
+    """``background="none"`` fits no negatives even where the model has its
+    own; a variant fits its own ``SyntheticBackground``; ``n_jobs=2`` fits
+    the cells in worker processes, one torch thread each, in cells of their
+    own, and scores them as the serial run scores its own."""
+    made = bench_decoding.build_model("full20", 0, True, "none")
+    assert made.background is None
+    made = bench_decoding.build_model("full20", 0, True, "share10-nofragment", 1)
+    assert made.background.n_sequences == 0.1
+    assert made.background.kinds == bench_decoding.NO_FRAGMENT
+    assert made.named_steps["tagger"].fit_threads == 1
+    with pytest.raises(ValueError, match="unknown background 'noise'"):
+        bench_decoding.background_of("noise", 0)
+    serial = bench_decoding.run(
+        quick=True, datasets=["quick B"], out_dir=tmp_path / "serial", n_jobs=1
+    )
+    parallel = bench_decoding.run(
+        quick=True, datasets=["quick B"], out_dir=tmp_path / "jobs", n_jobs=2
+    )
+    cells = sorted((tmp_path / "jobs").rglob("*.npz"))
+    assert len(cells) == 1 and "-t1-" in cells[0].name
+    assert not any("-t" in c.name for c in (tmp_path / "serial").rglob("*.npz"))
+    # one thread or two: the same seed, the same tiny network, nearly the same
+    # probabilities, so the default decodes to close scores
+    (a,) = [r for r in _settings(serial) if r["default"]]
+    (b,) = [r for r in _settings(parallel) if r["default"]]
+    assert b["jaccard"]["quick B"] == pytest.approx(a["jaccard"]["quick B"], abs=0.05)
+
+
+def test_a_variant_makes_the_kinds_it_asks_for_that_the_data_can_give():
+    """A variant without fragments fits on data whose every gesture is its own
+    reversal (as UTKinect's sit down / stand up may be): it drops
+    ``"reversed"`` there instead of failing the fit, and keeps it elsewhere."""
+    X, y = _ramps()
+    for x, lab in zip(X, y):
+        for c, s, e in labels_to_segments(lab):
+            x[s:e, c - 1] = np.sin(np.linspace(0, np.pi, e - s))  # out and back
+    variant = bench_decoding.background_of("nofragment", 0)
+    made = variant.make(X, y)
+    kinds = {k for pieces in made.pieces for k, _, _ in pieces}
+    assert "reversed" not in kinds and "motion" in kinds
+    with pytest.raises(ValueError, match="'reversed'"):  # the strict object
+        bench_decoding.SyntheticBackground(kinds=variant.kinds).make(X, y)
+    X, y = _ramps()  # ramps (slow, then fast): reversible
+    kinds = {k for p in variant.make(X, y).pieces for k, _, _ in p}
+    assert "reversed" in kinds
