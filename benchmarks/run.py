@@ -31,6 +31,10 @@ SECTIONS = {
         "bench_decoding",
         "Decoding defaults by their worst case: Jaccard change, false events/min",
     ),
+    "background": (
+        "bench_background",
+        "Synthetic negatives by their cost: Jaccard change, false events/min",
+    ),
     "compare": (
         "bench_compare",
         "skgesture beside the peers (seed means; cached in bench_results/compare)",
