@@ -79,13 +79,20 @@ negatives (``synthetic B`` resampled to 15 fps, so that the rate path runs);
 ``bench_oov.make_model``'s tiny tagger, seed 0, ``QUICK_GRID``. Its cache goes
 under the output folder too.
 
-``--background synthetic`` fits ``make_recommended(background="synthetic")``
-instead (12 synthetic negatives made from every training fold): the same table
-for that model, in cache cells and a figure of its own.
+``--background NAME`` fits the variant ``NAME`` of ``BACKGROUNDS`` instead
+of the model's own background: ``synthetic`` is
+``make_recommended(background="synthetic")`` (12 synthetic negatives made
+from every training fold), ``none`` no negatives, the others vary their count
+(``share10``: 10 % of the training sequences) and kinds (``nofragment``);
+each in cache cells and a figure of its own (``bench_background.py`` sets
+them side by side). ``--jobs N`` fits the missing cells in N worker
+processes, each tagger on ``cpu_count // N`` threads, in cells of their own
+(``-t<threads>``). ``--default-only`` decodes the current default alone.
 
 Usage: ``python benchmarks/bench_decoding.py [--quick] [--seeds 0,1,2]
-[--datasets precog,utkinect,synthetic] [--out-dir DIR] [--background
-synthetic]``, or ``python benchmarks/run.py --only decoding``.
+[--datasets precog,utkinect,synthetic] [--out-dir DIR] [--background NAME]
+[--jobs N] [--default-only]``, or ``python benchmarks/run.py --only
+decoding``.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -122,7 +129,6 @@ from bench_oov import (  # noqa: E402
     quick_data,
 )
 from joblib import Parallel, delayed  # noqa: E402
-from sklearn.base import clone  # noqa: E402
 
 import skgesture  # noqa: E402
 from skgesture._rate import (  # noqa: E402
@@ -251,7 +257,6 @@ BACKGROUNDS = {
     "nofragment": {"kinds": NO_FRAGMENT},
     "share10": {"n_sequences": 0.1},
     "share10-nofragment": {"n_sequences": 0.1, "kinds": NO_FRAGMENT},
-    "share20-nofragment": {"n_sequences": 0.2, "kinds": NO_FRAGMENT},
 }
 
 
@@ -263,11 +268,8 @@ class PossibleKinds(SyntheticBackground):
     def make(self, X, y):
         kinds = self.kinds
         if kinds is not None:
-            kinds = [k for k in kinds if _can_make(X, y, k)]
-        return clone(self).set_params(kinds=kinds or None).make_all(X, y)
-
-    def make_all(self, X, y):
-        return super().make(X, y)
+            kinds = [k for k in kinds if _can_make(X, y, k)] or None
+        return SyntheticBackground(**{**self.get_params(), "kinds": kinds}).make(X, y)
 
 
 def _can_make(X, y, kind):
@@ -292,11 +294,10 @@ def background_of(name, seed):
 
 
 def build_model(joints, seed, quick, background=None, fit_threads=None):
-    """``make_recommended(joints=joints, random_state=seed)``, with the
-    background variant ``background`` (``background_of``; None: the model's
-    own); quick:
-    ``bench_oov.make_model``'s tiny tagger (20 joints), with the same
-    background. ``fit_threads`` (None: the model's) sets the tagger's."""
+    """``make_recommended(joints=joints, random_state=seed)`` (quick:
+    ``bench_oov.make_model``'s tiny tagger, 20 joints) with the background
+    variant ``background`` (``background_of``; None: the model's own);
+    ``fit_threads`` (None: the model's) sets the tagger's."""
     if quick:
         model = make_model(seed, quick=True)
     else:

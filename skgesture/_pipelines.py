@@ -276,10 +276,12 @@ def make_recommended(
         :class:`~skgesture.datasets.SyntheticBackground` (12 sequences of
         random joint motion, reversed gestures, fragments and concatenations,
         seeded by ``random_state``); None trains on the given data alone.
-        Synthetic negatives cut false events on everyday motion by a further
-        60 % and cost 0.02-0.05 Jaccard on every dataset (docs/safety.md),
-        hence not the default; recordings of your own ordinary work, added
-        to ``X`` with all-zero labels, are the stronger lever.
+        Synthetic negatives remove 58 % of the false events on everyday
+        motion and cost 0.016-0.045 Jaccard on the gesture datasets; fewer
+        of them cost less and remove less, none within 0.01 everywhere
+        (docs/safety.md), hence not the default; recordings of your own
+        ordinary work, added to ``X`` with all-zero labels, are the
+        stronger lever.
     memory : None, str or joblib.Memory, default=None
         Cache of the trained network, so that the decoding parameters
         (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``,
