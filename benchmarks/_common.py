@@ -97,6 +97,20 @@ def machine_line():
     )
 
 
+def comma_list(text):
+    """``"a, b,c"`` as ``["a", "b", "c"]`` (a command-line list); None or ""
+    as None."""
+    return [t.strip() for t in text.split(",") if t.strip()] if text else None
+
+
+def print_report(rows, format_tables, notes):
+    """Print a section's run on its own: the machine, its tables, its notes."""
+    print(machine_line() + "\n")
+    print(format_tables(rows))
+    for note in notes:
+        print(f"* {note}")
+
+
 def _code_only(source):
     """The source's syntax tree without docstrings: what runs, not its prose.
 

@@ -47,7 +47,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_decoding  # noqa: E402
-from _common import format_table, machine_line  # noqa: E402
+from _common import comma_list, format_table, print_report  # noqa: E402
 
 VARIANTS = ("none", "synthetic", "nofragment", "share10", "share10-nofragment")
 QUICK_VARIANTS = ("none", "synthetic", "share10-nofragment")
@@ -268,22 +268,15 @@ def main(argv=None):
     parser.add_argument("--jobs", type=int, default=1, help="fits at once")
     parser.add_argument("--out-dir", default=None, help="figure and cache folder")
     args = parser.parse_args(argv)
-
-    def split(text):
-        return [t.strip() for t in text.split(",") if t.strip()] if text else None
-
     rows = run(
         quick=args.quick,
-        seeds=[int(s) for s in split(args.seeds)] if args.seeds else None,
-        variants=split(args.variants),
-        datasets=split(args.datasets),
+        seeds=[int(s) for s in comma_list(args.seeds)] if args.seeds else None,
+        variants=comma_list(args.variants),
+        datasets=comma_list(args.datasets),
         out_dir=args.out_dir,
         n_jobs=args.jobs,
     )
-    print(machine_line() + "\n")
-    print(format_tables(rows))
-    for note in NOTES:
-        print(f"* {note}")
+    print_report(rows, format_tables, NOTES)
 
 
 if __name__ == "__main__":

@@ -114,7 +114,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import _code_only, format_table, machine_line  # noqa: E402
+from _common import (  # noqa: E402
+    _code_only,
+    comma_list,
+    format_table,
+    print_report,
+)
 from bench_compare import Folds, data_key, load_folds  # noqa: E402
 from bench_oov import (  # noqa: E402
     MIN_IOU,
@@ -902,21 +907,14 @@ def main(argv=None):
     args = parser.parse_args(argv)
     rows = run(
         quick=args.quick,
-        seeds=[int(s) for s in args.seeds.split(",")] if args.seeds else None,
-        datasets=(
-            [d.strip() for d in args.datasets.split(",") if d.strip()]
-            if args.datasets
-            else None
-        ),
+        seeds=[int(s) for s in comma_list(args.seeds)] if args.seeds else None,
+        datasets=comma_list(args.datasets),
         grid={} if args.default_only else None,
         out_dir=args.out_dir,
         background=args.background,
         n_jobs=args.jobs,
     )
-    print(machine_line() + "\n")
-    print(format_tables(rows))
-    for note in NOTES:
-        print(f"* {note}")
+    print_report(rows, format_tables, NOTES)
 
 
 if __name__ == "__main__":
