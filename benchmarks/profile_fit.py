@@ -5,7 +5,8 @@ PRECOG sequences (subjects 1-6, as the README's example) under cProfile, after
 one descriptor transform outside the profile (so numba's first compilation is
 not counted), and prints the seconds of each part: the descriptor of the
 training set, the crops and their augmentation (``_CropData.sample``), the
-network's forward pass, its backward pass, the optimiser step, and the rest.
+network's forward pass, its backward pass, the loss and the optimiser's
+update, and the training loop as a whole.
 cProfile slows the Python-heavy parts more than torch's kernels; compare the
 parts, not the total with an unprofiled fit.
 
@@ -66,7 +67,7 @@ def main(argv=None):
     )
     parts = {label: cumulative(stats, *where) for label, *where in PARTS}
     step = parts["whole optimiser step (forward, backward, update)"]
-    parts["optimiser update"] = step - parts["forward"] - parts["backward"]
+    parts["loss and optimiser update"] = step - parts["forward"] - parts["backward"]
     for label, seconds in parts.items():
         print(f"  {label:<50} {seconds:7.1f} s  {seconds / total:6.1%}")
 
