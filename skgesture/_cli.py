@@ -341,8 +341,9 @@ def build_parser():
         metavar="DIR",
         help="recordings of ordinary work with no command in them (a folder of "
         "your own recordings, read like DATA; labels are not needed), learnt "
-        "as rest so that everyday motion fires no gesture; 'synthetic' makes "
-        "background sequences from the training recordings "
+        "as rest so that everyday motion fires no gesture; 'synthetic' makes 12 "
+        "background sequences from the training recordings, as "
+        "make_recommended(background='synthetic') does "
         "(skgesture.datasets.make_background). May be given more than once",
     )
     p.add_argument(

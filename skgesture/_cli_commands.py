@@ -121,11 +121,14 @@ def cmd_train(args):
 def _background(args, data):
     """The ``--background`` sequences: skeletons, all rest (labels ignored)."""
     from skgesture import datasets
+    from skgesture._pipelines import BACKGROUND_SEQUENCES
 
     out = []
     for spec in args.background or ():
-        if spec == "synthetic":
-            made = datasets.make_background(data.X, data.y, random_state=args.seed)
+        if spec == "synthetic":  # as many as make_recommended(background=...)
+            made = datasets.make_background(
+                data.X, data.y, n_sequences=BACKGROUND_SEQUENCES, random_state=args.seed
+            )
             out += list(made.X)
             continue
         path = Path(spec).expanduser()

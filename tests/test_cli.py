@@ -1085,6 +1085,7 @@ def test_train_learns_background_recordings_as_rest(tmp_path, capsys, monkeypatc
     """--background DIR: the folder's recordings (no annotations needed) are
     training sequences whose every frame is rest; 'synthetic' makes them."""
     from skgesture._persistence import model_info
+    from skgesture._pipelines import BACKGROUND_SEQUENCES
 
     rng = np.random.default_rng(0)
     folder = tmp_path / "work"
@@ -1108,8 +1109,11 @@ def test_train_learns_background_recordings_as_rest(tmp_path, capsys, monkeypatc
              "--background", "synthetic", "-o", path], capsys,
         )  # fmt: skip
     assert status == 0, err
-    # 3 gesture streams, then the 2 recordings, then the synthetic ones
-    assert len(seen["X"]) > 5 and [len(x) for x in seen["X"][3:5]] == [80, 80]
+    # 3 gesture streams, then the 2 recordings, then the synthetic ones: as
+    # many as make_recommended(background="synthetic") makes at every fit
+    made = skgesture.make_recommended(background="synthetic").background
+    assert len(seen["X"]) == 5 + made.n_sequences == 5 + BACKGROUND_SEQUENCES
+    assert [len(x) for x in seen["X"][3:5]] == [80, 80]
     assert all(not y.any() for y in seen["y"][3:])
     assert any(y.any() for y in seen["y"][:3])
     meta = model_info(path)["metadata"]
