@@ -103,6 +103,17 @@ def comma_list(text):
     return [t.strip() for t in text.split(",") if t.strip()] if text else None
 
 
+def save_figure(fig, path, dpi=110):
+    """Write a benchmark's matplotlib figure to ``path`` (its folder made when
+    missing), close it, and return ``path``."""
+    import matplotlib.pyplot as plt
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def print_report(rows, format_tables, notes):
     """Print a section's run on its own: the machine, its tables, its notes."""
     print(machine_line() + "\n")

@@ -47,7 +47,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_decoding  # noqa: E402
-from _common import comma_list, format_table, print_report  # noqa: E402
+from _common import (  # noqa: E402
+    comma_list,
+    format_table,
+    print_report,
+    save_figure,
+)
 
 VARIANTS = ("none", "synthetic", "nofragment", "share10", "share10-nofragment")
 QUICK_VARIANTS = ("none", "synthetic", "share10-nofragment")
@@ -220,10 +225,7 @@ def plot_backgrounds(rows, path):
     ax.set_title("synthetic negatives in fit: what they cost, what they remove")
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def format_tables(rows, title="Synthetic negatives by their cost"):

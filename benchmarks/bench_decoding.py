@@ -119,6 +119,7 @@ from _common import (  # noqa: E402
     comma_list,
     format_table,
     print_report,
+    save_figure,
 )
 from bench_compare import Folds, data_key, load_folds  # noqa: E402
 from bench_oov import (  # noqa: E402
@@ -700,6 +701,7 @@ def run(
     )
     cache_dir = out_dir / "decoding"
     fit_threads = None if n_jobs == 1 else max(1, (os.cpu_count() or 1) // n_jobs)
+    variant = (background, fit_threads)  # what a cell's name adds to its key
     plan, missing = [], []  # every cell, and the ones to fit
     for name, folds in folds_of.items():
         joints = joints_of(name, quick)
@@ -717,13 +719,13 @@ def run(
             make = functools.partial(
                 build_model, joints, seed, quick, background, fit_threads
             )
+            info = {"dataset": folds.name, "joints": joints, "seed": seed, "key": key}
             for fold in folds.folds:
-                where = (background, fit_threads)
-                path = _cell_path(cache_dir, folds, joints, seed, fold[0], key, *where)
+                path = _cell_path(
+                    cache_dir, folds, joints, seed, fold[0], key, *variant
+                )
                 plan.append((name, seed, fold, make, path))
                 if not path.exists():
-                    info = {"dataset": folds.name, "joints": joints, "seed": seed}
-                    info["key"] = key
                     missing.append((name, folds, fold, make, rate, negs, path, info))
     if missing:
         verbose = not quick
@@ -848,10 +850,7 @@ def plot_settings(rows, path):
     ax.set_title("decoding settings (dotted: the tolerance)")
     ax.legend(fontsize=7, loc="lower center")
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def format_tables(rows, title="Decoding defaults by their worst case"):

@@ -57,7 +57,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import format_table, machine_line
+from _common import format_table, machine_line, save_figure
 
 from skgesture import (
     TorchMLPClassifier,
@@ -569,10 +569,7 @@ def plot_tradeoff(rows, path):
              "its defaults) +- 0.01; dotted: the 10-frame aim", ha="center",
              fontsize=8)  # fmt: skip
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def format_tables(rows, title=None):
