@@ -689,6 +689,8 @@ def run(
         (``{dataset: "seedsxfolds"}``); then one ``table="figure"`` row
         (``path``).
     """
+    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int) or n_jobs < 1:
+        raise ValueError(f"n_jobs must be an int >= 1 (fits at once), got {n_jobs!r}")
     NOTES.clear()
     out_dir = Path(out_dir or os.environ.get(OUT_ENV) or RESULTS)
     seeds = tuple(seeds) if seeds is not None else (QUICK_SEEDS if quick else SEEDS)

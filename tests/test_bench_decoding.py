@@ -277,6 +277,9 @@ def test_background_variants_and_parallel_fits(tmp_path):
     assert made.named_steps["tagger"].fit_threads == 1
     with pytest.raises(ValueError, match="unknown background 'noise'"):
         bench_decoding.background_of("noise", 0)
+    for bad in (0, -1, 1.5):  # before any fit
+        with pytest.raises(ValueError, match=f"n_jobs must be an int >= 1.*{bad}"):
+            bench_decoding.run(quick=True, out_dir=tmp_path, n_jobs=bad)
     serial = bench_decoding.run(
         quick=True, datasets=["quick B"], out_dir=tmp_path / "serial", n_jobs=1
     )
