@@ -261,6 +261,43 @@ def test_training_crops_keep_labels_aligned(toy):
     assert np.all(np.abs(bump[yb == 0]) < 1.5)
 
 
+def test_training_crops_get_the_noise_of_the_raw_features_on_kept_frames_only():
+    """The noise is drawn per batch, after standardisation: it must be the
+    augmenter's ``noise`` in raw units on every real frame, none on padding,
+    and the same batches for the same seed."""
+    from skgesture._nn._sequence_net import _CropData
+
+    X = [np.zeros((n, 4), np.float32) for n in (30, 500, 500)]
+    y = [np.zeros(len(x), np.int64) for x in X]
+    scale = np.array([1.0, 2.0, 0.5, 4.0])
+
+    def batch(noise, seed=0):
+        data = _CropData(
+            X, y, crop_length=64, mean=np.zeros(4), scale=scale, seed=seed,
+            augmenter=SkeletonAugmenter(rotation=0, scale=0, time_warp=0, noise=noise),
+        )  # fmt: skip
+        xb, yb = data.sample(256)
+        return xb.numpy(), yb.numpy()
+
+    xb, yb = batch(0.3)
+    real = yb != -100
+    assert (~real).any() and real.any()  # the 30-frame sequence is padded
+    assert np.all(xb[~real] == 0)
+    raw = xb[real] * scale  # back to the raw features' units
+    np.testing.assert_allclose(raw.std(axis=0), 0.3, rtol=0.03)
+    np.testing.assert_allclose(raw.mean(axis=0), 0.0, atol=0.01)
+    np.testing.assert_array_equal(batch(0.3)[0], xb)
+    assert not np.array_equal(batch(0.3, seed=1)[0], xb)
+    assert np.all(batch(0.0)[0] == 0)
+    # the augmenter alone, asked for no noise, adds none
+    x = np.ones((20, 3), np.float32)
+    aug = SkeletonAugmenter(rotation=0, scale=0, time_warp=0, noise=0.5)
+    np.testing.assert_array_equal(
+        aug.augment(x, y[0][:20], np.random.RandomState(0), noise=False)[0], x
+    )
+    assert not np.array_equal(aug.augment(x, y[0][:20], np.random.RandomState(0))[0], x)
+
+
 # -- JointFeatures -----------------------------------------------------------------
 
 
@@ -421,7 +458,7 @@ def test_after_training_with_background_random_joint_motion_gives_no_event():
         tagger = SequenceTagger(
             architecture="tcn", hidden_sizes=(16,), tcn_layers=5, tcn_stages=2,
             dropout=0.3, smoothing_weight=0.15, crop_length=96, batch_size=8,
-            steps_per_epoch=10, max_epochs=15, min_run=5, random_state=0,
+            steps_per_epoch=10, max_epochs=20, min_run=5, random_state=0,
             augment=SkeletonAugmenter(rotation=20.0, scale=0.15, noise=0.02),
         )  # fmt: skip
         return make_pipeline(JointFeatures(), tagger).fit(X, y)
@@ -430,9 +467,9 @@ def test_after_training_with_background_random_joint_motion_gives_no_event():
         return sum(len(labels_to_segments(p)) for p in model.predict(X))
 
     alone = fit(train.X, train.y)
-    assert n_events(alone, motion.X) >= 1  # 3 to 11 events over seeds 0-4
+    assert n_events(alone, motion.X) >= 1  # 1 to 8 events over seeds 0-4
     model = fit(train.X + background.X, train.y + background.y)
-    assert n_events(model, motion.X) == 0
+    assert n_events(model, motion.X) == 0  # 0 for each of seeds 0-4
     # ... and it still finds the gestures of the held-out streams
     assert n_events(model, test.X) >= sum(len(s) for s in test.segments) // 2
     assert jaccard_index(test.y, model.predict(test.X)) > 0.35

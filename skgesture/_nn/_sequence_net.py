@@ -31,7 +31,11 @@ class _CropData(torch.utils.data.Dataset):
     Each crop is a random ``crop_length``-frame slice of a random sequence,
     perturbed by ``augmenter`` (before standardisation, so rotations act on
     raw xyz triples) and standardised; a shorter sequence is padded, its
-    padding left out of the loss.
+    padding left out of the loss. The augmenter's Gaussian noise is drawn
+    for the whole batch at once, in torch, on the kept frames only: ``noise``
+    in the raw features' units is ``noise / scale`` once standardised, so the
+    crops are distributed as if each had been noised before its
+    standardisation, at a third of the cost.
     """
 
     def __init__(self, X, y, *, crop_length, augmenter, mean, scale, seed):
@@ -42,6 +46,7 @@ class _CropData(torch.utils.data.Dataset):
         self.scale = scale.astype(np.float32)
         self.seed = seed
         self.rng = np.random.RandomState(seed)
+        self.noise_generator = torch.Generator().manual_seed(int(seed))
 
     def __len__(self):
         return len(self.X)
@@ -71,6 +76,7 @@ class _CropData(torch.utils.data.Dataset):
         rng, length = self.rng, self.crop_length
         xb = np.zeros((batch_size, length, self.mean.size), dtype=np.float32)
         yb = np.full((batch_size, length), IGNORE_INDEX, dtype=np.int64)
+        kept = np.zeros((batch_size, length, 1), dtype=bool)
         for b in range(batch_size):
             i = rng.randint(len(self.X))
             x, y = self.X[i], self.y[i]
@@ -80,13 +86,19 @@ class _CropData(torch.utils.data.Dataset):
                 if len(x) > margin:
                     s = rng.randint(len(x) - margin + 1)
                     x, y = x[s : s + margin], y[s : s + margin]
-                x, y = self.augmenter.augment(x, y, rng)
+                x, y = self.augmenter.augment(x, y, rng, noise=False)
             if len(x) > length:
                 s = rng.randint(len(x) - length + 1)
                 x, y = x[s : s + length], y[s : s + length]
             xb[b, : len(x)] = (x - self.mean) / self.scale
             yb[b, : len(y)] = y
-        return torch.from_numpy(xb), torch.from_numpy(yb)
+            kept[b, : len(x)] = True
+        xb, yb = torch.from_numpy(xb), torch.from_numpy(yb)
+        if self.augmenter is not None and self.augmenter.noise:
+            std = torch.from_numpy(np.float32(self.augmenter.noise) / self.scale)
+            noise = torch.randn(xb.shape, generator=self.noise_generator)
+            xb += torch.where(torch.from_numpy(kept), noise * std, 0.0)
+        return xb, yb
 
 
 class _CropBatches:
