@@ -30,20 +30,22 @@
   (``lost``/``extra``: segments without an exact match; ``frames_equal``:
   frames labelled alike, the measure for the recommended model, whose bounded
   look-ahead moves boundaries).
-* ``window``: the recommended model (``make_recommended``, method ``R`` in
-  every table: JointFeatures and the whole-sequence tagger, streamed over a
-  trailing window) with the tagger's look-ahead ``tagger__stream_future``,
-  the features' warm-up and, for a tagger without a recurrent state (TCN),
-  its window of past frames ``tagger__stream_past``, against agreement with
-  offline, Jaccard, delay and the CPU time of a push (back to back,
-  p50/p99); nothing is retrained.
+* ``window``: the whole-sequence variant of the recommended model
+  (``make_recommended(lookahead=None)``, method ``W``: a TCN that reads
+  whole sequences offline, streamed over a trailing window) with the
+  tagger's look-ahead ``tagger__stream_future``, the features' warm-up
+  (where its features have one) and, for a tagger without a recurrent state
+  (TCN), its window of past frames ``tagger__stream_past``, against
+  agreement with offline, Jaccard, delay and the CPU time of a push (back to
+  back, p50/p99); nothing is retrained.
 
-Method ``X`` is ``make_recommended(lookahead=8)``, the recommended model
-built to stream exactly (running feature statistics, a causal TCN read 8
-frames late): in ``latency`` and ``delay`` beside ``R``.
+Method ``R`` is ``make_recommended()`` as it is, the model built to stream
+exactly (a causal TCN read 8 frames late, then the decoding's own lag): its
+``agreement`` and ``frames_equal`` must be 1. Method ``W`` is its
+whole-sequence variant, in ``latency``, ``delay`` and ``window``.
 
 ``python benchmarks/bench_streaming.py [--quick] [--sections latency ...]
-[--methods ABCR] [--set tagger__architecture=tcn ...]`` prints the tables
+[--methods ABCRW] [--set tagger__architecture=tcn ...]`` prints the tables
 (``--set``: ``set_params`` of the recommended model before training);
 ``run(quick, sections, recommended_params, methods)`` returns the rows. ``--quick``
 trains on less data for fewer epochs, streams fewer frames and soaks 12,000
@@ -103,9 +105,6 @@ TABLE_COLUMNS = {
 }  # fmt: skip
 
 
-EXACT_LOOKAHEAD = 8  # frames; the event delay is this + 2 (features, decoding)
-
-
 def _networks(quick):
     """The paper's segmenter and window network sizes (docs/method.md §4.2, §5.4);
     fewer SCG epochs than MATLAB's 1000 (latency does not depend on them)."""
@@ -124,17 +123,10 @@ def _pipelines(quick, recommended_params=None):
         pipe = make_method_c(random_state=0)
         return pipe.set_params(tagger__max_epochs=8) if quick else pipe
 
-    def recommended():
+    def recommended(**kwargs):
         # Its defaults (streaming ones included); --quick trains fewer epochs.
-        pipe = make_recommended(random_state=0).set_params(**(recommended_params or {}))
-        if quick:
-            epochs = [k for k in pipe.get_params() if k.endswith("max_epochs")]
-            pipe.set_params(**dict.fromkeys(epochs, 4))
-        return pipe
-
-    def exact():
-        # make_recommended(lookahead=8): it streams exactly what it predicts
-        pipe = make_recommended(lookahead=EXACT_LOOKAHEAD, random_state=0)
+        pipe = make_recommended(random_state=0, **kwargs)
+        pipe.set_params(**(recommended_params or {}))
         if quick:
             epochs = [k for k in pipe.get_params() if k.endswith("max_epochs")]
             pipe.set_params(**dict.fromkeys(epochs, 4))
@@ -145,7 +137,8 @@ def _pipelines(quick, recommended_params=None):
         "B": lambda: make_method_b(random_state=0).set_params(**_networks(quick)),
         "C": method_c,
         "R": recommended,
-        "X": exact,
+        # the whole-sequence variant, streamed over a trailing window
+        "W": lambda: recommended(lookahead=None),
     }
 
 
@@ -330,19 +323,21 @@ def _tradeoff(pipe, method, name, X_te, y_te, fps, quick):
 
 
 def _window(pipe, name, X_te, y_te, fps, quick):
-    """The recommended model's look-ahead and warm-up (stream-only parameters,
-    nothing retrained) against agreement with offline, Jaccard, delay and CPU."""
+    """The whole-sequence model's look-ahead and warm-up (stream-only
+    parameters, nothing retrained) against agreement with offline, Jaccard,
+    delay and CPU. Features without a warm-up (the descriptor: each row is
+    its frame's own) are run at their one setting, ``warmup`` None."""
     future_key = f"{pipe.steps[-1][0]}__stream_future"
     warmup_key = f"{pipe.steps[0][0]}__stream_warmup"
-    params = pipe.get_params()
-    default = {future_key: params[future_key], warmup_key: params[warmup_key]}
-    reference = _offline_jaccard(pipe, X_te, y_te)
     past_key = f"{pipe.steps[-1][0]}__stream_past"
-    default[past_key] = params[past_key]
+    params = pipe.get_params()
+    default = {k: params[k] for k in (future_key, warmup_key, past_key) if k in params}
+    reference = _offline_jaccard(pipe, X_te, y_te)
     futures = (2, 8, 32) if quick else FUTURES
     settings = [{**default, future_key: f} for f in futures]
-    warmups = [w for w in WARMUPS if w != default[warmup_key]]
-    settings += [{**default, warmup_key: w} for w in warmups]
+    if warmup_key in default:
+        warmups = [w for w in WARMUPS if w != default[warmup_key]]
+        settings += [{**default, warmup_key: w} for w in warmups]
     if not _carries_state(pipe[-1]):  # a window of past frames: its length too
         pasts = [p for p in PASTS if p != default[past_key]]
         settings += [{**default, past_key: p} for p in pasts]
@@ -353,9 +348,9 @@ def _window(pipe, name, X_te, y_te, fps, quick):
             rec = StreamingRecognizer(pipe)
             cpu = _latency(pipe, X_te, 600 if quick else 2000, paced=False)
             rows.append({
-                "section": "window", "data": name, "method": "R",
+                "section": "window", "data": name, "method": "W",
                 "future": setting[future_key], "past": setting[past_key],
-                "warmup": setting[warmup_key],
+                "warmup": setting.get(warmup_key),
                 "max_delay": rec.max_delay, "jaccard_offline": reference,
                 **_stream_scores(rec, X_te, y_te, fps, pipe),
                 "cpu_p50_us": cpu["cpu_p50_us"], "cpu_p99_us": cpu["cpu_p99_us"],
@@ -430,7 +425,7 @@ def _soak(pipe, method, streams, n_frames):
     }  # fmt: skip
 
 
-def run(quick=False, sections=SECTIONS, recommended_params=None, methods="ABCR"):
+def run(quick=False, sections=SECTIONS, recommended_params=None, methods="ABCRW"):
     """Run the sections and return their rows.
 
     Parameters
@@ -442,8 +437,9 @@ def run(quick=False, sections=SECTIONS, recommended_params=None, methods="ABCR")
     recommended_params : dict or None, default=None
         ``set_params`` of the recommended model before it is trained (e.g.
         ``{"tagger__architecture": "tcn"}``), to measure another set-up.
-    methods : str, default="ABCR"
-        The methods measured (``R``: the recommended model).
+    methods : str, default="ABCRW"
+        The methods measured (``R``: the recommended model, ``W``: its
+        whole-sequence variant).
 
     Returns
     -------
@@ -454,7 +450,7 @@ def run(quick=False, sections=SECTIONS, recommended_params=None, methods="ABCR")
     rows, fitted = [], {}
     needed = set()
     for section, used in (
-        ("latency", "ABCRX"), ("delay", "ABCRX"), ("tradeoff", "BC"), ("window", "R"),
+        ("latency", "ABCRW"), ("delay", "ABCRW"), ("tradeoff", "BC"), ("window", "W"),
         ("soak", "BR"),
     ):  # fmt: skip
         if section in sections:
@@ -487,7 +483,7 @@ def run(quick=False, sections=SECTIONS, recommended_params=None, methods="ABCR")
                 })  # fmt: skip
             if "tradeoff" in sections and method in ("B", "C"):
                 rows += _tradeoff(pipe, method, name, X_te, y_te, fps, quick)
-            if "window" in sections and method == "R":
+            if "window" in sections and method == "W":
                 rows += _window(pipe, name, X_te, y_te, fps, quick)
     if "soak" in sections:
         for method in ("B", "R"):
@@ -548,15 +544,15 @@ def plot_tradeoff(rows, path):
             key=lambda r: r["future"],
         )
         if curve:
-            refs["R"] = curve[0]["jaccard_offline"]
+            refs["W"] = curve[0]["jaccard_offline"]
             line = ax.plot([r["delay_median"] for r in curve],
                            [r["jaccard"] for r in curve], "D-",
-                           label="recommended (labels: look-ahead)")[0]  # fmt: skip
+                           label="whole-sequence (labels: look-ahead)")[0]  # fmt: skip
             for r in curve:
                 ax.annotate(f"L{r['future']}", (r["delay_median"], r["jaccard"]),
                             textcoords="offset points", xytext=(3, -9), fontsize=7,
                             color=line.get_color())  # fmt: skip
-        colours = {"B": "tab:blue", "C": "tab:green", "R": "tab:red", "X": "tab:purple"}
+        colours = {"B": "tab:blue", "C": "tab:green", "W": "tab:red"}
         for method, ref in refs.items():
             ax.axhspan(ref - 0.01, ref + 0.01, alpha=0.12,
                        color=colours[method])  # fmt: skip
@@ -565,7 +561,7 @@ def plot_tradeoff(rows, path):
         ax.set_xlabel("median decision delay (frames after the gesture ends)")
         ax.set_ylabel("Jaccard index of the streamed events")
         ax.legend(fontsize=8, loc="best", framealpha=0.6)
-    fig.text(0.5, 0.005, "bands: offline Jaccard (B, C: the paper's span 15; R: "
+    fig.text(0.5, 0.005, "bands: offline Jaccard (B, C: the paper's span 15; W: "
              "its defaults) +- 0.01; dotted: the 10-frame aim", ha="center",
              fontsize=8)  # fmt: skip
     fig.tight_layout(rect=(0, 0.03, 1, 1))
@@ -609,8 +605,9 @@ def main():
         help="measurements to take",
     )  # fmt: skip
     parser.add_argument(
-        "--methods", default="ABCR",
-        help="methods to measure: any of A, B, C and R (the recommended model)",
+        "--methods", default="ABCRW",
+        help="methods to measure: any of A, B, C, R (the recommended model) and W "
+        "(its whole-sequence variant)",
     )  # fmt: skip
     parser.add_argument(
         "--set", nargs="+", default=[], metavar="PARAM=VALUE",
