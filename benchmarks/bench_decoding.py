@@ -83,7 +83,8 @@ under the output folder too.
 of the model's own background: ``synthetic`` is
 ``make_recommended(background="synthetic")`` (12 synthetic negatives made
 from every training fold), ``none`` no negatives, the others vary their count
-(``share10``: 10 % of the training sequences) and kinds (``nofragment``);
+(``share10``: 10 % of the training sequences) and kinds (``nofragment``;
+``motion``: random joint motion alone);
 each in cache cells and a figure of its own (``bench_background.py`` sets
 them side by side). ``--jobs N`` fits the missing cells in N worker
 processes, each tagger on ``cpu_count // N`` threads, in cells of their own
@@ -172,6 +173,7 @@ PARAMS = (
     "min_duration",
     "max_duration",
     "viterbi_penalty",
+    "max_novelty",
 )
 GRID = {
     "smooth_span": (1, 5),
@@ -180,6 +182,7 @@ GRID = {
     "min_duration": (0.0, 0.3, 0.5),
     "max_duration": (None, 1.5, 2.5),  # None: no limit
     "viterbi_penalty": (None, 2.0, 5.0, 10.0),  # None: the arg-max path
+    "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0),  # None: no limit
 }
 QUICK_GRID = {
     "smooth_span": (1, 5),
@@ -188,6 +191,7 @@ QUICK_GRID = {
     "min_duration": (0.0, 0.5),
     "max_duration": (None, 2.5),
     "viterbi_penalty": (None, 5.0),
+    "max_novelty": (None, 1.75),
 }
 TOLERANCE = 0.005  # the chosen setting loses at most this Jaccard anywhere
 PROBA_DTYPE = np.float32  # of the cache: the network's softmax is float32
@@ -263,6 +267,7 @@ BACKGROUNDS = {
     "nofragment": {"kinds": NO_FRAGMENT},
     "share10": {"n_sequences": 0.1},
     "share10-nofragment": {"n_sequences": 0.1, "kinds": NO_FRAGMENT},
+    "motion": {"kinds": ("motion",)},
 }
 
 
@@ -316,19 +321,28 @@ def build_model(joints, seed, quick, background=None, fit_threads=None):
 
 
 def model_rate_proba(model, X, rates):
-    """The tagger's raw probabilities and untracked rows at the model's rate.
+    """The tagger's raw probabilities, untracked rows and novelty at the
+    model's rate.
 
     A sequence whose rate (None: rows as frames) differs from ``model.fps_``
-    is resampled to it first; then ``model[:-1].transform`` and the tagger's
-    ``_proba``, as ``predict`` does. Returns a list of ``(proba, untracked)``,
-    proba as ``PROBA_DTYPE``.
+    is resampled to it first; then ``model[:-1].transform``, the tagger's
+    ``_proba``, as ``predict`` does, and the novelty of every frame for every
+    class (``tagger.novelty_.score``, what ``max_novelty`` reads). Returns a
+    list of ``(proba, untracked, novelty)``, proba and novelty as
+    ``PROBA_DTYPE``.
     """
     fps = model.fps_
     Xm = [x if r is None else resample(x, r, fps) for x, r in zip(X, rates)]
-    proba, untracked = model[-1]._proba(model[:-1].transform(Xm))
+    F = model[:-1].transform(Xm)
+    tagger = model[-1]
+    proba, untracked = tagger._proba(F)
     return [
-        (np.asarray(p, dtype=PROBA_DTYPE), np.asarray(u, dtype=bool))
-        for p, u in zip(proba, untracked)
+        (
+            np.asarray(p, dtype=PROBA_DTYPE),
+            np.asarray(u, dtype=bool),
+            np.asarray(tagger.novelty_.score(f), dtype=PROBA_DTYPE),
+        )
+        for p, u, f in zip(proba, untracked, F)
     ]
 
 
@@ -336,9 +350,9 @@ def fit_cell(make, X_tr, y_tr, X_te, rate, negatives):
     """Fit ``make()`` and return its probabilities (a cache cell).
 
     ``{"meta": {"classes", "class_lengths", "fps", "input_fps", "fit_s",
-    "proba_s", "negatives"}, "test": [(proba, untracked), ...], "negatives":
-    {name: [(proba, untracked), ...]}}``; ``rate`` is the rate of the training
-    and test sequences (None: rows as frames).
+    "proba_s", "negatives"}, "test": [(proba, untracked, novelty), ...],
+    "negatives": {name: [(proba, untracked, novelty), ...]}}``; ``rate`` is
+    the rate of the training and test sequences (None: rows as frames).
     """
     model = make()
     t0 = time.perf_counter()
@@ -397,8 +411,9 @@ def save_cell(path, cell):
         (f"neg{k}", cell["negatives"][n]) for k, n in enumerate(cell["negatives"])
     ]
     for prefix, rows in parts:
-        for i, (p, u) in enumerate(rows):
+        for i, (p, u, n) in enumerate(rows):
             arrays[f"{prefix}_p{i}"], arrays[f"{prefix}_u{i}"] = p, u
+            arrays[f"{prefix}_n{i}"] = n
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
     with open(tmp, "wb") as fh:
@@ -413,7 +428,10 @@ def load_cell(path):
 
         def rows(prefix):
             n = sum(1 for k in f.files if k.startswith(f"{prefix}_p"))
-            return [(f[f"{prefix}_p{i}"], f[f"{prefix}_u{i}"]) for i in range(n)]
+            return [
+                (f[f"{prefix}_p{i}"], f[f"{prefix}_u{i}"], f[f"{prefix}_n{i}"])
+                for i in range(n)
+            ]
 
         neg = {n: rows(f"neg{k}") for k, n in enumerate(meta["negatives"])}
         return {"meta": meta, "test": rows("test"), "negatives": neg}
@@ -455,13 +473,25 @@ def decoder(make, meta):
     tagger.classes_ = np.asarray(meta["classes"])
     tagger.class_lengths_ = np.asarray(meta["class_lengths"], dtype=float)
     tagger.class_long_lengths_ = np.asarray(meta["class_long_lengths"], dtype=float)
+    tagger.novelty_ = CachedNovelty()
     return tagger
 
 
-def decode_back(tagger, proba, untracked, rate, fps, n_frames):
+class CachedNovelty:
+    """Stands in for a fitted tagger's ``novelty_`` in :func:`decode_back`:
+    the "features" it is given are the cell's novelty of every frame for
+    every class (``model_rate_proba``), so ``score(rows, k)`` is column
+    ``k``, the scores ``PoseNovelty.score`` gave."""
+
+    def score(self, rows, k=None):
+        rows = np.asarray(rows, dtype=np.float64)
+        return rows if k is None else rows[:, k]
+
+
+def decode_back(tagger, proba, untracked, novelty, rate, fps, n_frames):
     """Labels and events ``(class, start, end, confidence)`` in input frames."""
     p = np.asarray(proba, dtype=np.float64)  # as predict decodes them
-    labels = tagger._decode(p, untracked)
+    labels = tagger._decode(p, untracked, novelty)
     segs = segments_with_confidence(labels, p, tagger.classes_)
     if rate is None or same_rate(rate, fps):
         return labels, segs
@@ -484,8 +514,8 @@ def score_cell(cell, tagger, settings, y_te, truth, negatives):
     for setting in settings:
         tagger.set_params(**setting)
         decoded = [
-            decode_back(tagger, p, u, rate, fps, len(y))
-            for (p, u), y in zip(cell["test"], y_te)
+            decode_back(tagger, p, u, n, rate, fps, len(y))
+            for (p, u, n), y in zip(cell["test"], y_te)
         ]
         score = {"jaccard": float(jaccard_index(y_te, [d[0] for d in decoded]))}
         if truth is not None:
@@ -494,8 +524,8 @@ def score_cell(cell, tagger, settings, y_te, truth, negatives):
             score.update(found=float(recall * n) if n else 0.0, gestures=n)
         score["events"] = {
             name: sum(
-                len(decode_back(tagger, p, u, f, fps, len(x))[1])
-                for (p, u), x, f in zip(
+                len(decode_back(tagger, p, u, n, f, fps, len(x))[1])
+                for (p, u, n), x, f in zip(
                     cell["negatives"][name], negatives[name].X, negatives[name].fps
                 )
             )
@@ -903,14 +933,29 @@ def main(argv=None):
         help="decode with the current default alone (to compare fits, not decodings)",
     )
     parser.add_argument(
+        "--vary",
+        default=None,
+        help="comma-separated parameters of PARAMS: the default with these "
+        "alone varied over GRID (a smaller grid)",
+    )
+    parser.add_argument(
         "--jobs", type=int, default=1, help="fits at once (worker processes)"
     )
     args = parser.parse_args(argv)
+    grid = None
+    if args.default_only:
+        grid = {}
+    elif args.vary:
+        unknown = [p for p in comma_list(args.vary) if p not in GRID]
+        if unknown:
+            parser.error(f"--vary: unknown parameters {unknown}; use {list(PARAMS)}")
+        values = QUICK_GRID if args.quick else GRID
+        grid = {p: values[p] for p in comma_list(args.vary)}
     rows = run(
         quick=args.quick,
         seeds=[int(s) for s in comma_list(args.seeds)] if args.seeds else None,
         datasets=comma_list(args.datasets),
-        grid={} if args.default_only else None,
+        grid=grid,
         out_dir=args.out_dir,
         background=args.background,
         n_jobs=args.jobs,

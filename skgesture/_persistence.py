@@ -91,6 +91,7 @@ _SUPPORT_CLASSES = (
     ("skgesture.layouts", "DescriptorJoints"),
     ("skgesture.layouts", "SkeletonLayout"),
     ("skgesture.datasets", "SyntheticBackground"),  # a GesturePipeline's background
+    ("skgesture.utils", "PoseNovelty"),  # a SequenceTagger's novelty_
 )
 
 

@@ -171,6 +171,40 @@ def test_false_events_do_not_rise_with_min_confidence(quick_run):
     assert drops > 0  # the floor removes events, so the check bites
 
 
+def test_false_events_do_not_rise_as_max_novelty_falls(quick_run):
+    _, rows, _ = quick_run
+    groups = defaultdict(dict)
+    for r in _settings(rows):
+        others = tuple(r["setting"][p] for p in PARAMS if p != "max_novelty")
+        groups[others][r["setting"]["max_novelty"]] = r
+    limits = bench_decoding.QUICK_GRID["max_novelty"]
+    assert limits[0] is None
+    for key, group in groups.items():
+        if len(group) < len(limits):  # the default, added alone
+            continue
+        events = [group[limit]["events_per_min"] for limit in limits]
+        assert events[1] <= events[0], key
+
+
+def test_vary_decodes_the_default_with_one_parameter_varied(
+    quick_run, monkeypatch, capsys, tmp_path
+):
+    import shutil
+
+    out, _, _ = quick_run
+    shutil.copytree(out / "decoding", tmp_path / "decoding")  # its own figure
+    out = tmp_path
+    monkeypatch.setattr(GesturePipeline, "fit", None)  # the cache answers
+    bench_decoding.main(["--quick", "--vary", "max_novelty", "--out-dir", str(out)])
+    text = capsys.readouterr().out
+    rows = [line for line in text.splitlines() if line.startswith("| ")][1:]
+    limits = bench_decoding.QUICK_GRID["max_novelty"]
+    default = bench_decoding.current_default()["max_novelty"]
+    assert len(rows) == len(set(limits) | {default})
+    with pytest.raises(SystemExit):
+        bench_decoding.main(["--quick", "--vary", "nonsense", "--out-dir", str(out)])
+
+
 def test_default_row_is_what_the_pipeline_predicts(quick_run):
     """The cached probabilities, decoded with the defaults, give the fitted
     pipeline's own ``predict`` / ``predict_segments`` (synthetic B at 15 fps:

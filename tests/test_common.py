@@ -126,7 +126,7 @@ BAD_PARAMS = {
         "n_iter_no_change": 0, "smooth_span": 0, "smoothing": "gaussian",
         "min_run": 0, "max_gap": -1, "min_confidence": 1.5,
         "min_duration": -0.5, "max_duration": 0.0, "viterbi_penalty": -1.0,
-        "viterbi_duration": "long",
+        "viterbi_duration": "long", "max_novelty": 0.0,
         "viterbi_lag": 1.5, "memory": 3, "device": 0, "n_threads": 0,
         "random_state": "seed", "verbose": "loud", "stream_past": -1,
         "stream_future": 2.5, "lookahead": -1, "fit_threads": "every",

@@ -299,3 +299,31 @@ def test_the_viterbi_path_streams_exactly(exact_model, lag):
     without = tagger.set_params(viterbi_penalty=None).stream_lookahead
     assert rec.delays["tagger"] == without + lag
     assert delays and max(delays) <= rec.max_delay
+
+
+def test_novel_runs_stream_exactly(exact_model):
+    # the novelty rule judges each run on its own, once it has ended, from
+    # each frame's own features: the live events are the offline ones
+    import copy
+
+    pipe = copy.deepcopy(exact_model[0])
+    X = exact_model[1]
+    tagger = pipe[-1]
+    F = pipe[:-1].transform(X)
+    before = tagger.predict_segments(F)
+    # a limit between two runs' median novelty: some runs go, some stay
+    medians = sorted(
+        float(np.median(tagger.novelty_.score(f[int(s) : int(e)], k)))
+        for f, segs in zip(F, before)
+        for c, s, e, _ in segs
+        for k in [int(np.searchsorted(tagger.classes_, c))]
+    )
+    middle = len(medians) // 2
+    tagger.set_params(max_novelty=(medians[middle - 1] + medians[middle]) / 2)
+    after = tagger.predict_segments(F)
+    assert 0 < sum(len(s) for s in after) < sum(len(s) for s in before)
+    for x, segments in zip(X, after):
+        events = StreamingRecognizer(pipe).recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))
+        assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)

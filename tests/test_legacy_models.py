@@ -244,7 +244,11 @@ def test_new_files_record_public_names(fitted, tmp_path):
             if cls in public:
                 assert module == "skgesture", f"{module}.{cls} in {key}.skg"
             else:  # private helpers keep their path
-                assert module in ("skgesture._persistence", "skgesture.layouts")
+                assert module in (
+                    "skgesture._persistence",
+                    "skgesture.layouts",
+                    "skgesture.utils",
+                )
         seen |= {c for m, c in ours if m == "skgesture"}
         text = json.dumps(_schema(path))
         assert "skgesture._descriptor" not in text and "skgesture._taggers" not in text

@@ -506,6 +506,7 @@ def test_trusted_types_are_the_public_api_and_what_it_holds():
     assert {TorchMLPClassifier, skgesture.PoseDescriptor} <= public
     support = {layouts.DescriptorJoints, layouts.SkeletonLayout, _NetSlot, _TensorSlot}
     support.add(skgesture.datasets.SyntheticBackground)  # a pipeline's background
+    support.add(skgesture.utils.PoseNovelty)  # a SequenceTagger's novelty_
     names = _trusted_type_names()
     resolved = {}
     for name in names:

@@ -341,6 +341,76 @@ def test_min_confidence_drops_the_unsure_runs_only():
     assert not any(p.any() for p in tagger.predict(x_test))
 
 
+def test_max_novelty_rejects_motion_unlike_the_training_gestures():
+    # the bump is learnt with the other features at rest; the same bump while
+    # the rest of the body is in a pose never seen (someone carrying, bending)
+    # is a gesture to the network, and rest once novelty is limited
+    tagger = TRAINED["sequence"]().fit(*_streams(3))
+    assert tagger.novelty_.units_[0] == np.inf and np.isfinite(
+        tagger.novelty_.units_[1]
+    )
+    x_test, y_test = _streams(2, seed=5)
+    odd = x_test[1].copy()
+    odd[:, 1:3] += 1.0
+    plain = tagger.predict([x_test[0], odd])
+    assert plain[1][22:38].mean() > 0.8  # the network says gesture
+    tagger.set_params(max_novelty=2.0)  # no refit: a decoding rule
+    kept, rejected = tagger.predict([x_test[0], odd])
+    assert_array_equal(kept, plain[0])
+    assert (kept[22:38] == 1).all() and not rejected.any()
+    # the true gesture is near 1 unit from the training frames of its class
+    score = tagger.novelty_.score(x_test[0][22:38], 1)
+    assert np.median(score) < 2.0 < np.median(tagger.novelty_.score(odd[22:38], 1))
+    assert_array_equal(tagger.novelty_.score(odd)[:, 1], tagger.novelty_.score(odd, 1))
+    assert not tagger.novelty_.score(odd)[:, 0].any()  # rest is never novel
+
+
+def test_novelty_learns_from_tracked_frames_and_needs_two_sequences_a_class():
+    from skgesture.utils import PoseNovelty
+
+    X, y = _streams(3)
+    y[0][45:50] = 2  # class 2 in one sequence only: no held-out view of it
+    X[1][20:30] = 0.0  # untracked frames, labelled 1, must not enter the bank
+    tracked = [np.any(x != 0, axis=1) for x in X]
+    nov = PoseNovelty(n_components=3, bank_size=16).fit(
+        X, y, np.array([0, 1, 2]), tracked=tracked
+    )
+    assert nov.components_.shape == (3, 4)
+    assert len(nov.banks_[1]) == 16 and not np.isfinite(nov.units_[2])
+    assert not (
+        np.abs(nov.banks_[1] - nov._project(np.zeros((1, 4)))).sum(1) < 1e-9
+    ).any()
+    assert not nov.score(X[0])[:, 2].any()  # never novel without a unit
+
+
+def test_the_novelty_rule_judges_each_run_by_its_median_and_needs_the_rows():
+    from skgesture._taggers._decoding import LabelRuns, reject_runs
+
+    lab = np.array([0, 1, 1, 1, 0, 1, 1, 0])
+    raw = np.eye(2)[lab]
+    far = {1: 0.5, 2: 3.0, 3: 0.5, 5: 3.0, 6: 3.0}  # median 0.5, then 3.0
+
+    def novelty(s, e, k):
+        return np.array([far[i] for i in range(s, e)])
+
+    kept = reject_runs(lab, raw, np.arange(2), novelty=novelty, max_novelty=1.0)
+    assert kept.tolist() == [0, 1, 1, 1, 0, 0, 0, 0]
+    with pytest.raises(ValueError, match="novelty"):
+        reject_runs(lab, raw, np.arange(2), max_novelty=1.0)
+    runs = LabelRuns(np.arange(2), 1, max_novelty=1.0)
+    with pytest.raises(ValueError, match="novelty"):
+        runs.feed(0, raw, raw, np.zeros(len(lab), bool), np.arange(len(lab)))
+
+
+def test_max_novelty_on_a_model_fitted_without_novelty_says_so():
+    tagger = TAGGERS["sequence"](random_state=0).fit(*_streams())
+    del tagger.novelty_  # a model saved before the rule existed
+    tagger.predict(_streams(1)[0])  # the rule off: no novelty needed
+    tagger.set_params(max_novelty=2.0)
+    with pytest.raises(ValueError, match="novelty_.*refit it"):
+        tagger.predict(_streams(1)[0])
+
+
 @pytest.mark.parametrize(
     "attribute, rule, off",
     [

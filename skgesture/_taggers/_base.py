@@ -31,6 +31,7 @@ from skgesture._taggers._decoding import (
     ViterbiRule,
     class_lengths,
     decode,
+    novelty_of,
     segments_with_confidence,
 )
 from skgesture._taggers._stream import TrailingWindowStream
@@ -177,7 +178,10 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             frames are rest (0).
         """
         proba, untracked = self._proba(X)
-        return [self._decode(p, rows) for p, rows in zip(proba, untracked)]
+        features = self._novelty_features(X)
+        return [
+            self._decode(p, rows, x) for p, rows, x in zip(proba, untracked, features)
+        ]
 
     def predict_segments(self, X):
         """Gesture instances with their confidence.
@@ -195,9 +199,10 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             over the run.
         """
         proba, untracked = self._proba(X)
+        features = self._novelty_features(X)
         return [
-            segments_with_confidence(self._decode(p, rows), p, self.classes_)
-            for p, rows in zip(proba, untracked)
+            segments_with_confidence(self._decode(p, rows, x), p, self.classes_)
+            for p, rows, x in zip(proba, untracked, features)
         ]
 
     def score(self, X, y, sample_weight=None):
@@ -265,12 +270,20 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                 "class_long_lengths_", f"max_duration={longest}", "max_duration=None"
             )
             max_lengths = np.where(fitted > 0, longest * fitted, np.inf)
+        max_novelty = getattr(self, "max_novelty", None)
+        if max_novelty is not None and getattr(self, "novelty_", None) is None:
+            raise ValueError(
+                f"max_novelty={max_novelty} needs novelty_, which this "
+                f"{type(self).__name__} was fitted without: refit it, or set "
+                f"max_novelty=None"
+            )
         return {
             "min_run": self.min_run,
             "max_gap": self.max_gap,
             "min_confidence": float(getattr(self, "min_confidence", 0.0)),
             "min_lengths": lengths,
             "max_lengths": max_lengths,
+            "max_novelty": None if max_novelty is None else float(max_novelty),
             "viterbi": viterbi,
         }
 
@@ -285,15 +298,32 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
         return np.asarray(fitted, dtype=float)
 
-    def _decode(self, proba, untracked=None):
+    def _decode(self, proba, untracked=None, features=None):
+        """Labels of one sequence; ``features`` (its rows as ``fit`` saw them)
+        are read by the ``max_novelty`` rule alone, on the rows of the runs
+        it judges."""
+        rules = self._run_rules()
+        novelty = None
+        if rules["max_novelty"] is not None:
+            if features is None:
+                raise ValueError("max_novelty needs the sequence's features")
+            novelty = novelty_of(features, self.novelty_.score)
         return decode(
             proba,
             self.classes_,
             smooth_span=self.smooth_span,
             smoothing=self.smoothing,
             untracked=untracked,
-            **self._run_rules(),
+            novelty=novelty,
+            **rules,
         )
+
+    def _novelty_features(self, X):
+        """The features the ``max_novelty`` rule reads (None for each
+        sequence when the rule is off)."""
+        if getattr(self, "max_novelty", None) is None:
+            return [None] * len(X)
+        return check_sequences(X, ndim=2, estimator=self, reset=False)
 
     def __sklearn_tags__(self):
         tags = sequence_tags(super().__sklearn_tags__())
@@ -337,6 +367,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         past = getattr(self, "stream_past", DEFAULT_STREAM_PAST)
         with torch_threads(getattr(self, "n_threads", None)):
             scorer = self._stream_scorer(past)
+        rules = self._run_rules()
         return TrailingWindowStream(
             scorer,
             self.classes_,
@@ -346,7 +377,8 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             smoothing=self.smoothing,
             max_run=max_period,
             owner=f"{type(self).__name__}.smooth_span",
-            **self._run_rules(),
+            novelty=None if rules["max_novelty"] is None else self.novelty_.score,
+            **rules,
         )
 
     @property

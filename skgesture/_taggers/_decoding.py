@@ -159,16 +159,24 @@ def class_lengths(y, classes, *, quantile=LENGTH_QUANTILE):
 
 
 def reject_runs(
-    labels, raw, classes, *, min_confidence=0.0, min_lengths=None, max_lengths=None
+    labels,
+    raw,
+    classes,
+    *,
+    min_confidence=0.0,
+    min_lengths=None,
+    max_lengths=None,
+    novelty=None,
+    max_novelty=None,
 ):
-    """Set to rest the gesture runs too short or too long for their class, or
-    too unsure.
+    """Set to rest the gesture runs too short or too long for their class, too
+    unsure, or unlike its training poses.
 
     The last rules of the decoding, applied to every run on its own (so a
     stream decides a run as soon as it ends): a run of class ``c`` shorter
-    than ``min_lengths[c]`` frames, longer than ``max_lengths[c]`` frames, or
-    whose mean raw probability of ``c`` is below ``min_confidence``, becomes
-    rest.
+    than ``min_lengths[c]`` frames, longer than ``max_lengths[c]`` frames,
+    whose mean raw probability of ``c`` is below ``min_confidence``, or whose
+    median novelty for ``c`` is above ``max_novelty``, becomes rest.
 
     Parameters
     ----------
@@ -186,6 +194,13 @@ def reject_runs(
     max_lengths : ndarray of shape (n_classes,) or None, default=None
         Longest run kept per class, in frames (``inf``: no limit); None
         keeps every length.
+    novelty : callable or None, default=None
+        ``novelty(start, end, k)``: the novelty of rows ``start .. end - 1``
+        for the class of column ``k``
+        (:meth:`skgesture.utils.PoseNovelty.score`); needed when
+        ``max_novelty`` is set.
+    max_novelty : float or None, default=None
+        Highest median novelty of a run kept; None keeps every run.
 
     Returns
     -------
@@ -206,8 +221,15 @@ def reject_runs(
     [0, 0, 0, 0, 0, 0, 0, 0]
     """
     labels = np.array(labels, copy=True)
-    if min_confidence <= 0 and min_lengths is None and max_lengths is None:
+    if (
+        min_confidence <= 0
+        and min_lengths is None
+        and max_lengths is None
+        and max_novelty is None
+    ):
         return labels
+    if max_novelty is not None and novelty is None:
+        raise ValueError("max_novelty needs the novelty of the rows (novelty=)")
     classes = np.asarray(classes)
     starts, ends, values = runs(labels)
     for s, e, v in zip(starts.tolist(), ends.tolist(), values.tolist()):
@@ -220,6 +242,7 @@ def reject_runs(
             too_short
             or too_long
             or (min_confidence > 0 and raw[s:e, k].mean() < min_confidence)
+            or (max_novelty is not None and np.median(novelty(s, e, k)) > max_novelty)
         ):
             labels[s:e] = 0
     return labels
@@ -262,6 +285,8 @@ def apply_run_rules(
     min_confidence=0.0,
     min_lengths=None,
     max_lengths=None,
+    novelty=None,
+    max_novelty=None,
 ):
     """The rules of :func:`decode` that follow the path, on its labels.
 
@@ -289,7 +314,21 @@ def apply_run_rules(
         min_confidence=min_confidence,
         min_lengths=min_lengths,
         max_lengths=max_lengths,
+        novelty=novelty,
+        max_novelty=max_novelty,
     )
+
+
+def novelty_of(rows, score=None):
+    """The ``novelty(start, end, k)`` of :func:`reject_runs`.
+
+    ``score(rows[start:end], k)`` (feature rows and a scorer, offline:
+    :meth:`skgesture.utils.PoseNovelty.score`), or with ``score`` None
+    column ``k`` of ``rows``, scores computed already (a stream's).
+    """
+    if score is None:
+        return lambda s, e, k: rows[s:e, k]
+    return lambda s, e, k: score(rows[s:e], k)
 
 
 class ViterbiRule:
@@ -329,6 +368,8 @@ def decode(
     max_lengths=None,
     viterbi=None,
     raw=None,
+    novelty=None,
+    max_novelty=None,
 ):
     """Per-frame labels of one sequence from its class probabilities.
 
@@ -363,6 +404,12 @@ def decode(
     raw : ndarray of shape (n_frames, n_classes) or None, default=None
         The raw probabilities of those two rules when ``proba`` is already
         smoothed (a stream's); None: ``proba``.
+    novelty : callable or None, default=None
+        ``novelty(start, end, k)``, the novelty of rows ``start .. end - 1``
+        for column ``k`` (:func:`reject_runs`).
+    max_novelty : float or None, default=None
+        Gesture runs whose median novelty for their class is higher become
+        rest (:func:`reject_runs`).
 
     Returns
     -------
@@ -391,6 +438,8 @@ def decode(
         min_confidence=min_confidence,
         min_lengths=min_lengths,
         max_lengths=max_lengths,
+        novelty=novelty,
+        max_novelty=max_novelty,
     )
 
 
@@ -488,8 +537,10 @@ class LabelRuns:
         such cap). None: no cap.
     min_confidence : float, default=0.0
     min_lengths, max_lengths : ndarray of shape (n_classes,) or None, default=None
+    max_novelty : float or None, default=None
         The run rules of :func:`reject_runs`: they judge each run on its own,
-        so they move no cut.
+        so they move no cut. With ``max_novelty``, :meth:`feed` takes the
+        novelty of every row too.
     viterbi : ViterbiRule or None, default=None
         The path (:func:`best_path`); None: the arg-max.
 
@@ -521,6 +572,7 @@ class LabelRuns:
         min_lengths=None,
         max_lengths=None,
         viterbi=None,
+        max_novelty=None,
     ):
         self.classes = np.asarray(classes)
         self.min_run = int(min_run)
@@ -528,6 +580,7 @@ class LabelRuns:
         self.min_confidence = float(min_confidence)
         self.min_lengths = min_lengths
         self.max_lengths = max_lengths
+        self.max_novelty = max_novelty
         self.viterbi = viterbi
         self.path = None if viterbi is None else viterbi.path()
         self.lag = 0 if viterbi is None else viterbi.lag
@@ -535,6 +588,7 @@ class LabelRuns:
         n = len(self.classes)
         self.labels = RowBuffer((), dtype=self.classes.dtype, capacity=64)
         self.raw = RowBuffer((n,), capacity=64)
+        self.novelty = RowBuffer((n,), capacity=64)
         self.rest = RowBuffer((), dtype=bool, capacity=64)
         self.cs = 0  # first row of the stretch not yet decided
         self.n = 0  # rows labelled by the path
@@ -544,13 +598,18 @@ class LabelRuns:
         self.start = 0  # its first row
         self.before = 0  # label of the run before it
 
-    def feed(self, lo, smoothed, raw, rest, times):
-        """Rows ``lo ..`` in (smoothed and raw scores, rest flags, times); the
-        segments of the stretches they close out."""
+    def feed(self, lo, smoothed, raw, rest, times, novelty=None):
+        """Rows ``lo ..`` in (smoothed and raw scores, rest flags, times, and
+        with ``max_novelty`` their novelty); the segments of the stretches
+        they close out."""
         smoothed = np.asarray(smoothed)
         rest = np.asarray(rest, dtype=bool)
         if lo != self.fed:
             raise IndexError(f"rows fed out of order: {lo}, expected {self.fed}")
+        if self.max_novelty is not None:
+            if novelty is None:
+                raise ValueError("max_novelty is set: feed the rows' novelty too")
+            self.novelty.append(novelty)
         self.fed = lo + len(smoothed)
         self.raw.append(raw, rest)
         self.rest.append(rest)
@@ -606,6 +665,9 @@ class LabelRuns:
             return
         if self.gestures:
             raw = self.raw.data(cs, b)
+            novelty = None
+            if self.max_novelty is not None:
+                novelty = novelty_of(self.novelty.data(cs, b))
             labels = apply_run_rules(
                 self.labels.data(cs, b),
                 raw,
@@ -616,6 +678,8 @@ class LabelRuns:
                 min_confidence=self.min_confidence,
                 min_lengths=self.min_lengths,
                 max_lengths=self.max_lengths,
+                novelty=novelty,
+                max_novelty=self.max_novelty,
             )
             for cls, s, e, conf in segments_with_confidence(
                 labels, raw, self.classes
@@ -625,6 +689,8 @@ class LabelRuns:
         self.gestures = 0
         for buf in (self.labels, self.raw, self.rest):
             buf.drop(b)
+        if self.max_novelty is not None:
+            self.novelty.drop(b)
 
     def held(self):
         """Rows of the stretch not yet decided."""

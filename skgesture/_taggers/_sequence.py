@@ -17,11 +17,13 @@ from skgesture._nn._modules import (
     TemporalConvModule,
 )
 from skgesture._nn._sequence_net import _CropNet, predict_whole
+from skgesture._nn._training import IGNORE_INDEX
 from skgesture._taggers._base import (
     _DECODING_CONSTRAINTS,
     _STREAM_CONSTRAINTS,
     _BaseTagger,
 )
+from skgesture.utils import PoseNovelty
 
 __all__ = ["SequenceTagger"]
 
@@ -129,6 +131,15 @@ class SequenceTagger(_BaseTagger):
         ``fit``) become rest: a "gesture" that goes on for several times its
         usual length is walking, carrying or another activity. None: no
         limit.
+    max_novelty : float or None, default=None
+        Gesture runs whose poses are far from the training poses of their
+        class become rest: the median, over the run, of each frame's
+        distance to the nearest training frame of the class
+        (``novelty_``, fitted in ``fit`` from the features), in units of
+        the distance at which the class's training runs lie from the other
+        training sequences (its 95th percentile). A person walking, sitting
+        down or picking something up passes through poses no gesture has.
+        None: no limit (docs/safety.md, "The decoding rules").
     viterbi_penalty : float or None, default=None
         None: the labels are the arg-max of every frame. A float: they are
         the duration-aware Viterbi path (a gesture lasts at least
@@ -184,6 +195,10 @@ class SequenceTagger(_BaseTagger):
     class_long_lengths_ : ndarray of shape (n_classes,)
         The 90th percentile of every class's run lengths in ``fit``, in
         frames (0 for rest), the unit of ``max_duration``.
+    novelty_ : PoseNovelty
+        The training frames of every class (a bank of at most 256 of them,
+        standardised, on 24 principal components) and the unit of every
+        class's distance, read by ``max_novelty``.
     net_ : skorch.NeuralNet
         The trained network (``net_.history`` holds the losses).
     mean_ : ndarray of shape (n_features,)
@@ -256,6 +271,7 @@ class SequenceTagger(_BaseTagger):
             None,
         ],
         "augment": [SkeletonAugmenter, None],
+        "max_novelty": [None, Interval(Real, 0, None, closed="neither")],
         "standardize": ["boolean"],
         "early_stopping": ["boolean"],
         "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
@@ -305,6 +321,7 @@ class SequenceTagger(_BaseTagger):
         min_confidence=0.0,
         min_duration=0.0,
         max_duration=None,
+        max_novelty=None,
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
@@ -344,6 +361,7 @@ class SequenceTagger(_BaseTagger):
         self.min_confidence = min_confidence
         self.min_duration = min_duration
         self.max_duration = max_duration
+        self.max_novelty = max_novelty
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag
@@ -391,6 +409,12 @@ class SequenceTagger(_BaseTagger):
                 f"lookahead=None"
             )
         X, y_idx, classes = self._validate_fit(X, y)
+        self.novelty_ = PoseNovelty().fit(
+            X,
+            [classes[np.maximum(v, 0)] for v in y_idx],
+            classes,
+            tracked=[v != IGNORE_INDEX for v in y_idx],
+        )
         self._class_weight = _class_weights(self.class_weight, y_idx, len(classes))
         return self._fit_network([x.astype(np.float32) for x in X], y_idx, classes)
 

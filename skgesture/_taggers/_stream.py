@@ -249,9 +249,13 @@ class TrailingWindowStream:
         :class:`LabelRuns`).
     owner : str, default="smooth_span"
         Parameter name for error messages.
+    novelty : callable or None, default=None
+        ``novelty(rows) -> (len(rows), n_classes)``, the novelty of feature
+        rows (:meth:`skgesture.utils.PoseNovelty.score`), computed
+        for each row as it is scored; needed with ``max_novelty``.
     **run_rules : dict
-        ``min_confidence``, ``min_lengths``, ``max_lengths`` and ``viterbi`` of
-        :class:`LabelRuns`.
+        ``min_confidence``, ``min_lengths``, ``max_lengths``, ``max_novelty``
+        and ``viterbi`` of :class:`LabelRuns`.
 
     Examples
     --------
@@ -281,8 +285,12 @@ class TrailingWindowStream:
         max_gap=0,
         max_run=None,
         owner="smooth_span",
+        novelty=None,
         **run_rules,
     ):
+        if run_rules.get("max_novelty") is not None and novelty is None:
+            raise ValueError("max_novelty needs novelty=, the rows' novelty")
+        self.novelty = novelty if run_rules.get("max_novelty") is not None else None
         self.scorer = (
             proba if hasattr(proba, "reset") else WindowScorer(proba, lookback)
         )
@@ -297,6 +305,7 @@ class TrailingWindowStream:
         self.delay = self.lookahead + self.smoother.h + self.runs.lag + int(max_gap) + 1
         self.X = None
         self.raw = RowBuffer((len(self.classes),), capacity=64)
+        self.nov = RowBuffer((len(self.classes),), capacity=64)
         self.n_out = 0  # frames whose probabilities are computed
         self.last_time = 0
 
@@ -331,6 +340,8 @@ class TrailingWindowStream:
         rows are rest in the labels, after the smoothing, as offline)."""
         hi = u + len(p)
         self.raw.append(p, self.X.mask(u, hi), times)
+        if self.novelty is not None:
+            self.nov.append(self.novelty(self.X.data(u, hi)))
         self.n_out = hi
         return self._decide(*self.smoother.step(p, np.asarray(times)))
 
@@ -338,10 +349,12 @@ class TrailingWindowStream:
         if not len(smoothed):
             return []
         hi = lo + len(smoothed)
+        novelty = None if self.novelty is None else self.nov.data(lo, hi)
         out = self.runs.feed(
-            lo, smoothed, self.raw.data(lo, hi), self.raw.mask(lo, hi), times
+            lo, smoothed, self.raw.data(lo, hi), self.raw.mask(lo, hi), times, novelty
         )
         self.raw.drop(hi)
+        self.nov.drop(hi)
         return out
 
     def held(self):

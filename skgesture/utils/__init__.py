@@ -1,10 +1,12 @@
-"""Shared helpers: sequence validation, segments, smoothing, resizing, SCG.
+"""Shared helpers: sequence validation, segments, smoothing, resizing, SCG,
+the distance of frames to a recording's poses (PoseNovelty).
 
 ``SCG`` is imported lazily: ``import skgesture.utils`` does not import torch.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+from skgesture.utils._novelty import PoseNovelty
 from skgesture.utils._resize import imresize_weights, resize_frames
 from skgesture.utils._segments import (
     labels_to_segments,
@@ -31,6 +33,7 @@ __all__ = [
     "loess_kernel",
     "resize_frames",
     "imresize_weights",
+    "PoseNovelty",
     "SCG",
 ]
 
