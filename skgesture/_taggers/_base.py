@@ -140,11 +140,21 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
 
     def _proba(self, X):
         """The network's probabilities and the untracked rows of every sequence."""
+        proba, untracked, _ = self._scores(X)
+        return proba, untracked
+
+    def _scores(self, X):
+        """:meth:`_proba`'s probabilities and untracked rows, and the features
+        that the ``max_novelty`` rule reads (the checked sequences; None for
+        each sequence when the rule is off)."""
         check_is_fitted(self)
         data = check_sequences(X, ndim=2, estimator=self, reset=False)
         with torch_threads(self.n_threads):
             proba = self._raw_proba(data)
-        return proba, _untracked(X, data)
+        features = data
+        if getattr(self, "max_novelty", None) is None:
+            features = [None] * len(data)
+        return proba, _untracked(X, data), features
 
     def predict_proba(self, X):
         """Raw per-frame class probabilities (before smoothing).
@@ -177,8 +187,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             Labels from ``classes_`` after the decoding rules; untracked
             frames are rest (0).
         """
-        proba, untracked = self._proba(X)
-        features = self._novelty_features(X)
+        proba, untracked, features = self._scores(X)
         return [
             self._decode(p, rows, x) for p, rows, x in zip(proba, untracked, features)
         ]
@@ -198,8 +207,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             exclusive; the confidence is the mean raw probability of the class
             over the run.
         """
-        proba, untracked = self._proba(X)
-        features = self._novelty_features(X)
+        proba, untracked, features = self._scores(X)
         return [
             segments_with_confidence(self._decode(p, rows, x), p, self.classes_)
             for p, rows, x in zip(proba, untracked, features)
@@ -271,12 +279,8 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
             max_lengths = np.where(fitted > 0, longest * fitted, np.inf)
         max_novelty = getattr(self, "max_novelty", None)
-        if max_novelty is not None and getattr(self, "novelty_", None) is None:
-            raise ValueError(
-                f"max_novelty={max_novelty} needs novelty_, which this "
-                f"{type(self).__name__} was fitted without: refit it, or set "
-                f"max_novelty=None"
-            )
+        if max_novelty is not None:
+            self._fitted("novelty_", f"max_novelty={max_novelty}", "max_novelty=None")
         return {
             "min_run": self.min_run,
             "max_gap": self.max_gap,
@@ -288,15 +292,21 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         }
 
     def _fitted_lengths(self, attribute, rule, off):
-        """The fitted per-class lengths ``attribute`` that ``rule`` reads; a
-        clear error for a model fitted before the attribute existed."""
+        """The fitted per-class lengths ``attribute`` that ``rule`` reads
+        (:meth:`_fitted`)."""
+        return np.asarray(self._fitted(attribute, rule, off), dtype=float)
+
+    def _fitted(self, attribute, rule, off):
+        """The fitted ``attribute`` that ``rule`` reads; a clear error for a
+        model fitted before the attribute existed (``off``: how to do
+        without it)."""
         fitted = getattr(self, attribute, None)
         if fitted is None:
             raise ValueError(
                 f"{rule} needs {attribute}, which this {type(self).__name__} "
                 f"was fitted without: refit it, or set {off}"
             )
-        return np.asarray(fitted, dtype=float)
+        return fitted
 
     def _decode(self, proba, untracked=None, features=None):
         """Labels of one sequence; ``features`` (its rows as ``fit`` saw them)
@@ -317,13 +327,6 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             novelty=novelty,
             **rules,
         )
-
-    def _novelty_features(self, X):
-        """The features the ``max_novelty`` rule reads (None for each
-        sequence when the rule is off)."""
-        if getattr(self, "max_novelty", None) is None:
-            return [None] * len(X)
-        return check_sequences(X, ndim=2, estimator=self, reset=False)
 
     def __sklearn_tags__(self):
         tags = sequence_tags(super().__sklearn_tags__())
