@@ -381,6 +381,17 @@ def test_novelty_learns_from_tracked_frames_and_needs_two_sequences_a_class():
         np.abs(nov.banks_[1] - nov._project(np.zeros((1, 4)))).sum(1) < 1e-9
     ).any()
     assert not nov.score(X[0])[:, 2].any()  # never novel without a unit
+    # bad input is named, not crashed on
+    with pytest.raises(ValueError, match="empty"):
+        PoseNovelty().fit([], [], np.array([0, 1]))
+    with pytest.raises(ValueError, match="2 labels but X\\[0\\] has 60 frames"):
+        PoseNovelty().fit(X[:1], [y[0][:2]], np.array([0, 1]))
+    with pytest.raises(ValueError, match=r"shape \(n_frames, 4\).*\(5, 3\)"):
+        nov.score(np.ones((5, 3)))
+    bad = X[0].copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(ValueError, match="first at frame 7"):
+        nov.score(bad)
 
 
 def test_the_novelty_rule_judges_each_run_by_its_median_and_needs_the_rows():

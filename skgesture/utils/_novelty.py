@@ -19,6 +19,7 @@ offline.
 import numpy as np
 
 from skgesture.utils._segments import labels_to_segments
+from skgesture.utils._validation import check_sequence_labels, check_sequences
 
 N_COMPONENTS = 24  # principal components of the standardised features
 BANK_SIZE = 256  # training frames kept per class (evenly spaced)
@@ -117,6 +118,8 @@ class PoseNovelty:
         self : PoseNovelty
             The fitted object.
         """
+        X = check_sequences(X, ndim=2)
+        y = check_sequence_labels(y, X)
         classes = np.asarray(classes)
         if tracked is None:
             tracked = [np.ones(len(x), dtype=bool) for x in X]
@@ -185,6 +188,18 @@ class PoseNovelty:
             class, in units of the class's ``units_`` (rest, and a class
             without a unit: 0).
         """
+        x = np.asarray(x, dtype=np.float64)
+        if x.ndim != 2 or x.shape[1] != self.mean_.size:
+            raise ValueError(
+                f"x must be frames of shape (n_frames, {self.mean_.size}), as in "
+                f"fit; got an array of shape {x.shape}"
+            )
+        bad = ~np.isfinite(x).all(axis=1)
+        if bad.any():
+            raise ValueError(
+                f"x has NaN or infinite values (first at frame "
+                f"{int(np.argmax(bad))}): novelty needs finite features"
+            )
         Z = self._project(x)
         if k is not None:
             return self._column(Z, int(k))
