@@ -114,6 +114,14 @@ def save_figure(fig, path, dpi=110):
     return path
 
 
+def figure_lines(rows):
+    """The ``"figure: <path>"`` lines of a section's ``table="figure"`` rows,
+    to print under its tables."""
+    return "".join(
+        f"\nfigure: {r['path']}\n" for r in rows if r.get("table") == "figure"
+    )
+
+
 def print_report(rows, format_tables, notes):
     """Print a section's run on its own: the machine, its tables, its notes."""
     print(machine_line() + "\n")

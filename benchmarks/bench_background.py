@@ -49,6 +49,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_decoding  # noqa: E402
 from _common import (  # noqa: E402
     comma_list,
+    figure_lines,
     format_table,
     print_report,
     save_figure,
@@ -247,11 +248,7 @@ def format_tables(rows, title="Synthetic negatives by their cost"):
         line["false events/min"] = f"{fe:.2f}" + (f" ± {sd:.2f}" if sd else "")
         lines.append(line)
     columns = COLUMNS[:2] + [f"jaccard {d}" for d in datasets] + COLUMNS[2:]
-    out = format_table(lines, columns, title)
-    for r in rows:
-        if r.get("table") == "figure":
-            out += f"\nfigure: {r['path']}\n"
-    return out
+    return format_table(lines, columns, title) + figure_lines(rows)
 
 
 def main(argv=None):

@@ -121,6 +121,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import (  # noqa: E402
     _code_only,
     comma_list,
+    figure_lines,
     format_table,
     print_report,
     save_figure,
@@ -906,11 +907,7 @@ def format_tables(rows, title="Decoding defaults by their worst case"):
         line["false events/min"] = _pm(r["events_per_min"], r["events_per_min_sd"], 2)
         lines.append(line)
     columns = COLUMNS + [f"jaccard {d}" for d in datasets] + TAIL_COLUMNS
-    out = format_table(lines, columns, title)
-    for r in rows:
-        if r.get("table") == "figure":
-            out += f"\nfigure: {r['path']}\n"
-    return out
+    return format_table(lines, columns, title) + figure_lines(rows)
 
 
 def main(argv=None):
