@@ -62,13 +62,28 @@ def time_warp(x, y, rate):
     n = len(x)
     if n < 2:
         return x, (None if y is None else np.asarray(y))
-    m = max(int(round(n * rate)), 2)
-    src = np.linspace(0.0, n - 1, m)
-    lo = np.minimum(np.floor(src).astype(np.intp), n - 2)
-    w = (src - lo)[:, None].astype(x.dtype)
-    warped = x[lo] * (1 - w) + x[lo + 1] * w
+    src = _warp_grid(n, rate)
+    lo, w = _grid_weights(src, n, x.dtype)
+    warped = _interpolate(x, lo, w)
     labels = None if y is None else np.asarray(y)[np.rint(src).astype(np.intp)]
     return warped, labels
+
+
+def _warp_grid(n, rate):
+    """Source positions of the frames of an ``n``-frame sequence warped by
+    ``rate`` (at least 2 frames)."""
+    return np.linspace(0.0, n - 1, max(int(round(n * rate)), 2))
+
+
+def _grid_weights(src, n, dtype):
+    """The frame before every source position and the weight of the next."""
+    lo = np.minimum(np.floor(src).astype(np.intp), n - 2)
+    return lo, (src - lo)[:, None].astype(dtype)
+
+
+def _interpolate(x, lo, w):
+    """Rows ``lo`` and ``lo + 1`` of ``x`` mixed by ``w``."""
+    return x[lo] * (1 - w) + x[lo + 1] * w
 
 
 class SkeletonAugmenter(BaseEstimator):
@@ -131,7 +146,7 @@ class SkeletonAugmenter(BaseEstimator):
         self.time_warp = time_warp
         self.noise = noise
 
-    def augment(self, x, y, rng, *, noise=True):
+    def augment(self, x, y, rng, *, noise=True, length=None):
         """One random perturbation of a sequence and its labels.
 
         Parameters
@@ -149,6 +164,12 @@ class SkeletonAugmenter(BaseEstimator):
             for the frames it keeps (a third of its fit's time went to
             drawing it here, crop by crop, for frames that the crop then
             dropped).
+        length : int or None, default=None
+            An int: return a random crop of this many frames of the
+            perturbed sequence (all of it when it is shorter), the crop's
+            start drawn from ``rng`` after the perturbation's own draws, and
+            compute that crop's frames alone. ``SequenceTagger``'s crops
+            are a third shorter than the stretch it perturbs.
 
         Returns
         -------
@@ -158,7 +179,13 @@ class SkeletonAugmenter(BaseEstimator):
             Labels aligned with ``x_aug``.
         """
         self._validate_params()
+        return self._perturb(x, y, rng, noise=noise, length=length)
+
+    def _perturb(self, x, y, rng, *, noise=True, length=None):
+        """:meth:`augment` without the parameters' validation (a fit checks
+        them once, then perturbs thousands of crops)."""
         dtype = x.dtype
+        angle = factor = rate = None
         if self.rotation:
             if x.shape[1] % N_COORDS:
                 raise ValueError(
@@ -166,14 +193,28 @@ class SkeletonAugmenter(BaseEstimator):
                     f"{x.shape[1]} features; set rotation=0 for other features"
                 )
             angle = np.deg2rad(rng.uniform(-self.rotation, self.rotation))
-            c, s = np.cos(angle), np.sin(angle)
-            rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]], dtype=dtype)
-            x = (x.reshape(-1, N_COORDS) @ rot.T).reshape(x.shape)
         if self.scale:
-            x = x * dtype.type(rng.uniform(1 - self.scale, 1 + self.scale))
+            factor = rng.uniform(1 - self.scale, 1 + self.scale)
         if self.time_warp:
             rate = rng.uniform(1 - self.time_warp, 1 + self.time_warp)
-            x, y = time_warp(x, y, rate)
+        # The frames of the warped sequence (time_warp's arithmetic), then
+        # the crop; only the source frames the crop reads are perturbed.
+        n = len(x)
+        src = None if rate is None or n < 2 else _warp_grid(n, rate)
+        m = n if src is None else len(src)
+        start, stop = 0, m
+        if length is not None and m > length:
+            start = rng.randint(m - length + 1)
+            stop = start + length
+        if src is None:
+            x, y = x[start:stop], np.asarray(y)[start:stop]
+            x = self._rotate_scale(x, angle, factor)
+        else:
+            src = src[start:stop]
+            lo, w = _grid_weights(src, n, dtype)
+            part = self._rotate_scale(x[lo[0] : lo[-1] + 2], angle, factor)
+            x = _interpolate(part, lo - lo[0], w)
+            y = np.asarray(y)[np.rint(src).astype(np.intp)]
         if noise and self.noise:
             # float32 Gaussians of a Generator seeded from rng: 5x faster than
             # RandomState.normal, and as reproducible
@@ -181,3 +222,16 @@ class SkeletonAugmenter(BaseEstimator):
             noise = gen.standard_normal(x.shape, dtype=np.float32)
             x = x + (noise * np.float32(self.noise)).astype(dtype, copy=False)
         return np.ascontiguousarray(x, dtype=dtype), y
+
+    @staticmethod
+    def _rotate_scale(x, angle, factor):
+        """Frames rotated by ``angle`` about the vertical axis, then scaled
+        by ``factor`` (None: not at all)."""
+        dtype = x.dtype
+        if angle is not None:
+            c, s = np.cos(angle), np.sin(angle)
+            rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]], dtype=dtype)
+            x = (x.reshape(-1, N_COORDS) @ rot.T).reshape(x.shape)
+        if factor is not None:
+            x = x * dtype.type(factor)
+        return x

@@ -193,6 +193,60 @@ def test_mask_dropout_is_dropout():
     assert torch.allclose(y[y != 0], torch.tensor(1 / 0.7))
     assert torch.equal(drop.eval()(x), x)
     assert torch.equal(MaskDropout(0.0).train()(x), x)
+    # the same seed, the same mask; any shape, an odd count of values too
+    odd = torch.ones(3, 7, 5)
+    torch.manual_seed(1)
+    first = drop.train()(odd)
+    torch.manual_seed(1)
+    assert torch.equal(drop(odd), first)
+    assert 0 < int((first == 0).sum()) < odd.numel()
+    assert torch.equal(MaskDropout(1.0).train()(odd), torch.zeros_like(odd))
+
+
+def _conv_reference(module, X):
+    """The TCN of ``module`` written with torch's conv1d, channels first (the
+    form it was trained in before its time-major matrix products)."""
+    F = torch.nn.functional
+    x = X.transpose(1, 2)
+    L = module.lookahead or 0
+    x = F.pad(x, (0, L))
+    outputs = []
+    for k, stage in enumerate(module.stages):
+        h = F.conv1d(F.softmax(outputs[-1], dim=1) if k else x, stage.inp.weight,
+                     stage.inp.bias)  # fmt: skip
+        for layer in stage.layers:
+            d = layer.conv.dilation[0]
+            w, b = layer.conv.weight, layer.conv.bias
+            if module.lookahead is None:
+                a = F.conv1d(h, w, b, padding=d, dilation=d)
+            else:
+                a = F.conv1d(F.pad(h, (2 * d, 0)), w, b, dilation=d)
+            h = h + F.conv1d(F.relu(a), layer.mix.weight, layer.mix.bias)
+        outputs.append(F.conv1d(h, stage.out.weight, stage.out.bias))
+    return [o[:, :, L:].transpose(1, 2) for o in outputs]
+
+
+@pytest.mark.parametrize("lookahead", [None, 0, L])
+def test_tcn_computes_the_convolutions_of_its_parameters(lookahead):
+    """Every stage is the dilated convolutions of its ``Conv1d`` parameters
+    (so a model file saved before the matrix-product form predicts as it
+    did), gradients included."""
+    module = _module(lookahead, stages=3)
+    X = torch.randn(2, 40, 4)
+    with torch.no_grad():
+        for got, want in zip(module(X), _conv_reference(module, X), strict=True):
+            assert got.shape == want.shape == (2, 40, 3)
+            assert_allclose(got.numpy(), want.numpy(), atol=1e-5)
+    module.train()
+    for stage in module.stages:
+        for layer in stage.layers:
+            layer.dropout.p = 0.0
+    module(X)[-1].sum().backward()
+    mine = [p.grad.clone() for p in module.parameters()]
+    module.zero_grad()
+    _conv_reference(module, X)[-1].sum().backward()
+    for a, p in zip(mine, module.parameters(), strict=True):
+        assert_allclose(a.numpy(), p.grad.numpy(), rtol=1e-4, atol=1e-5)
 
 
 @pytest.mark.parametrize("features", ["descriptor", "joints"])

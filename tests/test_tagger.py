@@ -231,6 +231,26 @@ def test_augmenter_rotates_about_the_vertical_axis_and_keeps_lengths():
         aug.augment(x[:, :5], y, np.random.RandomState(0))
 
 
+def test_augmenter_crop_is_the_crop_of_the_whole_perturbation():
+    """``augment(length=n)`` computes only the frames it returns, and they are
+    those of the whole perturbation cropped at the next draw of ``rng``."""
+    x = np.random.RandomState(0).normal(size=(300, 9)).astype(np.float32)
+    y = np.arange(300) // 30
+    for params in ({}, {"rotation": 0, "scale": 0}, {"time_warp": 0}):
+        aug = SkeletonAugmenter(**params)
+        for seed in range(20):
+            for n, length in ((300, 64), (300, 400), (1, 8), (2, 1)):
+                rng = np.random.RandomState(seed)
+                xa, ya = aug.augment(x[:n], y[:n], rng, noise=False)
+                if len(xa) > length:
+                    s = rng.randint(len(xa) - length + 1)
+                    xa, ya = xa[s : s + length], ya[s : s + length]
+                rng = np.random.RandomState(seed)
+                xc, yc = aug.augment(x[:n], y[:n], rng, noise=False, length=length)
+                np.testing.assert_array_equal(xc, xa)
+                np.testing.assert_array_equal(yc, ya)
+
+
 @pytest.mark.parametrize(
     "params",
     [{"rotation": 200}, {"scale": 1.0}, {"time_warp": -0.1}, {"noise": -1.0}],

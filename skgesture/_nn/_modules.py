@@ -134,13 +134,16 @@ class RecurrentTaggerModule(nn.Module):
 
 
 class MaskDropout(nn.Module):
-    """``nn.Dropout`` drawn as one uniform tensor and a comparison.
+    """``nn.Dropout`` drawn as random integers and a comparison.
 
-    The same distribution (each value zeroed with probability ``p``, the
-    others scaled by ``1 / (1 - p)``), from ``torch.rand_like``: on the CPU
-    torch's dropout draws a Bernoulli value at a time, ten times slower than
-    the convolution it follows (it was the largest cost of training the
-    recommended model). The identity in eval mode.
+    Each value is zeroed with probability ``p`` and the others are scaled by
+    ``1 / (1 - p)``, as ``nn.Dropout`` does. On the CPU torch's dropout
+    draws a Bernoulli value at a time, and ``torch.rand_like`` a float at a
+    time; here one 64-bit draw gives the 32-bit integers of two values,
+    compared with ``p`` scaled to 2**32 (so ``p`` is exact to 2**-32, finer
+    than a float32 uniform's 2**-24), 2.5x cheaper than ``rand_like`` and
+    25x cheaper than ``nn.Dropout`` on the recommended model's layers. The
+    identity in eval mode.
     """
 
     def __init__(self, p=0.5):
@@ -152,8 +155,16 @@ class MaskDropout(nn.Module):
             return x
         if self.p >= 1.0:
             return torch.zeros_like(x)
-        keep = torch.rand_like(x) >= self.p
-        return x * keep * (1.0 / (1.0 - self.p))
+        return x * keep_mask(x, self.p) * (1.0 / (1.0 - self.p))
+
+
+def keep_mask(x, p):
+    """A boolean tensor shaped as ``x``: each value False with probability
+    ``p`` (to 2**-32), from torch's global generator of ``x``'s device."""
+    n = x.numel()
+    draws = torch.empty((n + 1) // 2, dtype=torch.int64, device=x.device)
+    values = draws.random_(-(2**63), None).view(torch.int32)[:n].view(x.shape)
+    return values >= int(round(p * 2**32)) - 2**31
 
 
 class _DilatedResidual(nn.Module):
@@ -175,13 +186,28 @@ class _DilatedResidual(nn.Module):
         self.mix = nn.Conv1d(channels, channels, 1)
         self.dropout = MaskDropout(dropout)
 
-    def forward(self, x):
-        if self.causal:
-            d = self.conv.dilation[0]
-            a = self.conv(F.pad(x, ((KERNEL - 1) * d, 0)))
-        else:
-            a = self.conv(x)
-        return x + self.dropout(self.mix(F.relu(a)))
+    def forward(self, h):
+        """``(batch, time, channels)`` in and out."""
+        d, n = self.conv.dilation[0], h.shape[1]
+        if self.causal:  # taps t - 2d, t - d, t; zeros before the first frame
+            z = F.pad(h, (0, 0, (KERNEL - 1) * d, 0))
+            taps = torch.cat([z[:, :n], z[:, d : d + n], z[:, 2 * d :]], dim=2)
+        else:  # taps t - d, t, t + d; zeros beyond both ends
+            z = F.pad(h, (0, 0, d, d))
+            taps = torch.cat([z[:, :n], h, z[:, 2 * d :]], dim=2)
+        a = F.linear(taps, stacked_taps(self.conv.weight), self.conv.bias)
+        return h + self.dropout(pointwise(self.mix, F.relu(a)))
+
+
+def stacked_taps(weight):
+    """A ``Conv1d`` weight ``(out, in, k)`` as ``(out, k * in)``: the linear
+    map of its ``k`` shifted inputs concatenated along the channels."""
+    return weight.permute(0, 2, 1).reshape(weight.shape[0], -1)
+
+
+def pointwise(conv, h):
+    """A kernel-1 ``Conv1d`` on ``(batch, time, channels)`` rows."""
+    return F.linear(h, conv.weight[:, :, 0], conv.bias)
 
 
 class _Stage(nn.Module):
@@ -194,10 +220,11 @@ class _Stage(nn.Module):
         self.out = nn.Conv1d(channels, n_outputs, 1)
 
     def forward(self, x):
-        h = self.inp(x)
+        """``(batch, time, features)`` in, ``(batch, time, outputs)`` out."""
+        h = pointwise(self.inp, x)
         for layer in self.layers:
             h = layer(h)
-        return self.out(h)
+        return pointwise(self.out, h)
 
 
 class TemporalConvModule(nn.Module):
@@ -257,16 +284,21 @@ class TemporalConvModule(nn.Module):
         )
 
     def forward(self, X):
-        x = X.transpose(1, 2)
+        # Time-major rows throughout: every convolution is one matrix product
+        # of its shifted inputs (stacked_taps), 1.8x faster to train on the
+        # CPU than torch's dilated conv1d, with the Conv1d parameters kept
+        # (so model files of before load) and the arithmetic of the numpy
+        # scorers of skgesture/_nn/_fast.py.
+        x = X
         if self.lookahead:
-            x = F.pad(x, (0, self.lookahead))
+            x = F.pad(x, (0, 0, 0, self.lookahead))
         out = self.stages[0](x)
         outputs = [out]
         for stage in self.stages[1:]:
-            out = stage(F.softmax(out, dim=1))
+            out = stage(F.softmax(out, dim=-1))
             outputs.append(out)
         L = self.lookahead or 0
-        return tuple(o[:, :, L:].transpose(1, 2) for o in outputs)
+        return tuple(o[:, L:] for o in outputs)
 
 
 _ACTIVATIONS = {
