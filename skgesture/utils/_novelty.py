@@ -132,7 +132,12 @@ class PoseNovelty:
         sample = (rows[_evenly(len(rows), PCA_ROWS)] - self.mean_) / self.scale_
         sample -= sample.mean(axis=0)
         k = int(min(self.n_components, *sample.shape))
-        self.components_ = np.linalg.svd(sample, full_matrices=False)[2][:k]
+        # The leading eigenvectors of the scatter matrix: the SVD's principal
+        # axes (up to sign, which no distance sees), 10x cheaper, and spared
+        # the multi-threaded SVD's stalls on a busy machine (11 s against
+        # 0.2 s on one thread, for 5000 x 426 rows).
+        values, vectors = np.linalg.eigh(sample.T @ sample)
+        self.components_ = vectors[:, np.argsort(values)[::-1][:k]].T.copy()
         Z = [self._project(x) for x in X]
         # frames of every class, with the sequence they come from
         labels = [np.where(t, np.asarray(v), -1) for v, t in zip(y, tracked)]
