@@ -35,6 +35,10 @@ SECTIONS = {
         "bench_background",
         "Synthetic negatives by their cost: Jaccard change, false events/min",
     ),
+    "speed": (
+        "bench_speed",
+        "Recommended model: fit, predict and --fast times against their targets",
+    ),
     "compare": (
         "bench_compare",
         "skgesture beside the peers (seed means; cached in bench_results/compare)",
