@@ -31,10 +31,12 @@ Protocol
 * **Decoding** (no refit): for every setting of ``GRID`` (smooth_span x min_run
   x min_confidence x min_duration x max_duration x viterbi_penalty x
   max_novelty, 576 settings; max_duration and max_novelty None are no limit,
-  viterbi_penalty None the arg-max path; ``viterbi_duration`` and
-  ``viterbi_lag`` stay the tagger's defaults, 0.7 and 6; the current default
-  is added when the grid lacks it; ``--vary NAME`` instead varies ``NAME``
-  alone over ``VARY``, the others at the default's values) the parameters
+  viterbi_penalty None the arg-max path; ``viterbi_duration`` stays the
+  tagger's default, 0.7, and ``viterbi_lag`` too, 6, but in ``VARY``; the
+  current default is added when the grid lacks it; ``--vary NAME`` instead
+  varies ``NAME`` alone over ``VARY``, the others at the default's values:
+  ``--vary viterbi_lag`` gives the Jaccard of every lag, the decoding's share
+  of the live delay) the parameters
   are set on the tagger (``tagger.set_params``) and ``tagger._decode(p,
   untracked, novelty)`` gives the labels (``novelty``: the cell's novelty of
   every frame, read through ``CachedNovelty``), ``segments_with_confidence``
@@ -178,6 +180,7 @@ PARAMS = (
     "max_duration",
     "viterbi_penalty",
     "max_novelty",
+    "viterbi_lag",
 )
 GRID = {
     "smooth_span": (1, 5),
@@ -188,7 +191,13 @@ GRID = {
     "viterbi_penalty": (None, 2.0, 5.0, 10.0),  # None: the arg-max path
     "max_novelty": (None, 1.75),  # None: no limit; VARY sweeps it
 }
-VARY = {**GRID, "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0)}  # --vary
+# --vary; viterbi_lag (frames between a frame and its decision, the live
+# delay's share of the decoding) stays the default in GRID
+VARY = {
+    **GRID,
+    "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0),
+    "viterbi_lag": (0, 1, 2, 3, 4, 6, 8),
+}
 QUICK_GRID = {
     "smooth_span": (1, 5),
     "min_run": (1,),
