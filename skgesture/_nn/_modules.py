@@ -141,9 +141,8 @@ class MaskDropout(nn.Module):
     draws a Bernoulli value at a time, and ``torch.rand_like`` a float at a
     time; here one 64-bit draw gives the 32-bit integers of two values,
     compared with ``p`` scaled to 2**32 (so ``p`` is exact to 2**-32, finer
-    than a float32 uniform's 2**-24), 2.5x cheaper than ``rand_like`` and
-    25x cheaper than ``nn.Dropout`` on the recommended model's layers. The
-    identity in eval mode.
+    than a float32 uniform's 2**-24): 2.5x cheaper than ``rand_like`` on the
+    recommended model's layers. The identity in eval mode.
     """
 
     def __init__(self, p=0.5):
@@ -285,8 +284,9 @@ class TemporalConvModule(nn.Module):
 
     def forward(self, X):
         # Time-major rows throughout: every convolution is one matrix product
-        # of its shifted inputs (stacked_taps), 1.8x faster to train on the
-        # CPU than torch's dilated conv1d, with the Conv1d parameters kept
+        # of its shifted inputs (stacked_taps): a training step's forward and
+        # backward 1.2x faster on the CPU than with torch's dilated conv1d
+        # (docs/benchmarks.md, "Where a fit's time goes"), the Conv1d parameters kept
         # (so model files of before load) and the arithmetic of the numpy
         # scorers of skgesture/_nn/_fast.py.
         x = X
