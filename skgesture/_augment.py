@@ -9,7 +9,7 @@ they stay aligned.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from numbers import Real
+from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator
@@ -179,6 +179,10 @@ class SkeletonAugmenter(BaseEstimator):
             Labels aligned with ``x_aug``.
         """
         self._validate_params()
+        if length is not None and (
+            isinstance(length, bool) or not isinstance(length, Integral) or length < 1
+        ):
+            raise ValueError(f"length must be a positive int or None, got {length!r}")
         return self._perturb(x, y, rng, noise=noise, length=length)
 
     def _perturb(self, x, y, rng, *, noise=True, length=None):

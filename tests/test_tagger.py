@@ -249,6 +249,9 @@ def test_augmenter_crop_is_the_crop_of_the_whole_perturbation():
                 xc, yc = aug.augment(x[:n], y[:n], rng, noise=False, length=length)
                 np.testing.assert_array_equal(xc, xa)
                 np.testing.assert_array_equal(yc, ya)
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(ValueError, match="length must be a positive int"):
+            aug.augment(x, y, np.random.RandomState(0), length=bad)
 
 
 @pytest.mark.parametrize(
