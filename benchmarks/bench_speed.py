@@ -40,7 +40,8 @@ them on a quiet machine (the load average at the start is in the notes).
 
 Quick mode (``run(quick=True)``, ``--quick``; a smoke run of the code, some
 seconds): 8 ``make_gesture_streams`` streams of 3 classes instead of PRECOG, a
-tiny tagger (``QUICK_TAGGER``: one epoch of 2 steps, one thread), one repeat,
+tiny tagger (``bench_oov.make_model``'s, trained for ``QUICK_TRAINING``: one
+epoch of 2 steps), one repeat,
 and ``train synthetic --n-sequences 8 --n-classes 3 --method recommended
 --fast --max-epochs 1``, BLAS on one thread in both (``QUICK_BLAS_ENV``: a
 smoke run in the test suite should not compete for the cores of the tests
@@ -71,8 +72,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import format_table, machine_line, median_time, print_report  # noqa: E402
+from bench_oov import make_model as oov_model  # noqa: E402
 
-from skgesture import make_recommended  # noqa: E402
 from skgesture.datasets import load_precog, make_gesture_streams  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -87,16 +88,8 @@ TARGET_TRAIN_FAST_S = 30.0  # issue 15: `skgesture train precog --fast`, whole c
 
 # Quick mode: a tiny tagger on tiny synthetic data (the targets do not apply).
 QUICK_DATA = {"n_sequences": 8, "n_classes": 3, "n_gestures": (3, 5)}
-QUICK_TAGGER = {
-    "tagger__hidden_sizes": (16,),
-    "tagger__tcn_layers": 3,
-    "tagger__tcn_stages": 1,
-    "tagger__crop_length": 64,
-    "tagger__batch_size": 8,
-    "tagger__max_epochs": 1,
-    "tagger__steps_per_epoch": 2,
-    "tagger__fit_threads": 1,  # a tiny network: one thread is fastest
-}
+# Quick mode: bench_oov's tiny tagger, trained for two steps.
+QUICK_TRAINING = {"tagger__max_epochs": 1, "tagger__steps_per_epoch": 2}
 # Quick mode's BLAS on one thread, in this process (threadpoolctl) and in the
 # train --fast subprocess (environment).
 QUICK_BLAS_ENV = {"OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
@@ -152,10 +145,11 @@ def _data(quick):
 
 
 def make_model(seed, quick):
-    """The recommended model on 20 joints; a tiny tagger in quick mode."""
-    model = make_recommended(joints="full20", random_state=seed)
+    """The recommended model on 20 joints (``bench_oov.make_model``); in quick
+    mode its tiny tagger, trained for ``QUICK_TRAINING``."""
+    model = oov_model(seed, quick)
     if quick:
-        model.set_params(**QUICK_TAGGER)
+        model.set_params(**QUICK_TRAINING)
     return model
 
 
