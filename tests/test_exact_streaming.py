@@ -115,34 +115,39 @@ def test_lookahead_is_for_the_tcn_only():
         SequenceTagger(architecture="gru", lookahead=4).fit(X, y)
 
 
-@pytest.fixture(scope="module")
-def exact_model():
+def _exact_pipeline(n_sequences=6, max_epochs=4, **tagger_params):
+    """A tiny exactly streaming pipeline fitted on all but 2 synthetic streams;
+    the pipeline and the 2 streams."""
     data = make_gesture_streams(
-        n_sequences=6, n_classes=3, n_gestures=(3, 4), random_state=0
+        n_sequences=n_sequences, n_classes=3, n_gestures=(3, 4), random_state=0
+    )
+    tagger = SequenceTagger(
+        architecture="tcn",
+        hidden_sizes=(16,),
+        tcn_layers=5,
+        lookahead=L,
+        max_epochs=max_epochs,
+        steps_per_epoch=10,
+        crop_length=96,
+        smooth_span=5,
+        min_run=5,
+        random_state=0,
+        **tagger_params,
     )
     pipe = Pipeline(
         [
             ("features", JointFeatures(statistics="running", fill="hold")),
-            (
-                "tagger",
-                SequenceTagger(
-                    architecture="tcn",
-                    hidden_sizes=(16,),
-                    tcn_layers=5,
-                    lookahead=L,
-                    max_epochs=4,
-                    steps_per_epoch=10,
-                    crop_length=96,
-                    smooth_span=5,
-                    min_run=5,
-                    random_state=0,
-                ),
-            ),
+            ("tagger", tagger),
         ]
     )
     with torch.random.fork_rng(devices=[]):
-        pipe.fit(data.X[:4], data.y[:4])
-    return pipe, data.X[4:]
+        pipe.fit(data.X[:-2], data.y[:-2])
+    return pipe, data.X[-2:]
+
+
+@pytest.fixture(scope="module")
+def exact_model():
+    return _exact_pipeline()
 
 
 def test_streamed_events_are_the_offline_segments(exact_model):
@@ -377,6 +382,28 @@ def test_novel_runs_stream_exactly(exact_model):
     after = tagger.predict_segments(F)
     assert 0 < sum(len(s) for s in after) < sum(len(s) for s in before)
     for x, segments in zip(X, after):
+        events = StreamingRecognizer(pipe).recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))
+        assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
+
+
+def test_named_runs_stream_exactly():
+    # the run namer names each run once it has ended, from its own rows: the
+    # live events are the offline ones (docs/design.md, "The run namer")
+    import copy
+
+    pipe, X = _exact_pipeline(
+        n_sequences=7, max_epochs=6, namer="gru", namer_weight=0.9
+    )
+    F = pipe[:-1].transform(X)
+    named = pipe[-1].predict_segments(F)
+    plain = copy.deepcopy(pipe[-1]).set_params(namer_weight=0.0).predict_segments(F)
+    # the namer changes some names (else this test could not fail)
+    assert any(
+        len(a) != len(b) or (a[:, 0] != b[:, 0]).any() for a, b in zip(named, plain)
+    )
+    for x, segments in zip(X, named):
         events = StreamingRecognizer(pipe).recognize(x)
         got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
         assert_array_equal(got, segments[:, :3].astype(int))

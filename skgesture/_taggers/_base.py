@@ -34,6 +34,7 @@ from skgesture._taggers._decoding import (
     novelty_of,
     segments_with_confidence,
 )
+from skgesture._taggers._namer import namer_batch, namer_of, namer_scores
 from skgesture._taggers._stream import TrailingWindowStream
 from skgesture._taggers._viterbi import chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
@@ -125,18 +126,65 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
 
     def _fit_network(self, X, y_idx, classes):
         network = self._network(len(classes))
-        threads = getattr(self, "fit_threads", None)
-        if threads is None:
-            threads = self.n_threads
-        elif threads == "all":
-            import os
-
-            threads = os.cpu_count() or 1
-        with torch_threads(threads):
+        with torch_threads(self._fit_threads()):
             fitted = fit_cached(self.memory, network, X, y_idx)
         self.classes_ = classes
         self._adopt(fitted)
         return self
+
+    def _fit_threads(self):
+        """Torch threads of a fit: ``fit_threads``, every core for "all", or
+        ``n_threads``."""
+        threads = getattr(self, "fit_threads", None)
+        if threads is None:
+            return self.n_threads
+        if threads == "all":
+            import os
+
+            return os.cpu_count() or 1
+        return threads
+
+    def _namer_rule(self, batch=False):
+        """``score(rows)``, the run namer's scores of a run's feature rows
+        (:func:`~skgesture._taggers._namer.namer_scores`; with ``batch``,
+        ``score(list of rows)``, :func:`~skgesture._taggers._namer.namer_batch`),
+        or None: no namer fitted, or ``namer_weight`` 0 (the runs keep the
+        path's labels)."""
+        fitted = getattr(self, "namer_", None)
+        if fitted is None or float(getattr(self, "namer_weight", 0.0)) <= 0:
+            return None
+        module, n_classes = fitted.module_, len(self.classes_)
+        mean, scale = self.namer_mean_, self.namer_scale_
+        threads = getattr(self, "n_threads", None)
+        scores = namer_batch if batch else namer_scores
+
+        def score(rows):
+            with torch_threads(threads):
+                return scores(module, mean, scale, rows, n_classes)
+
+        return score
+
+    def _decode_all(self, proba, untracked, features):
+        """:meth:`_decode` of every sequence; the run namer names the runs of
+        all of them in one batch: a first pass records the runs it is asked
+        for, then every sequence is decoded with their scores."""
+        batch = self._namer_rule(batch=True)
+        if batch is None:
+            return [self._decode(*args) for args in zip(proba, untracked, features)]
+        n_classes = len(self.classes_)
+        runs = []
+        for i, args in enumerate(zip(proba, untracked, features)):
+
+            def record(s, e, i=i):
+                runs.append((i, s, e))
+                return np.zeros(n_classes)
+
+            self._decode(*args, namer=record)
+        table = dict(zip(runs, batch([features[i][s:e] for i, s, e in runs])))
+        return [
+            self._decode(*args, namer=lambda s, e, i=i: table[(i, s, e)])
+            for i, args in enumerate(zip(proba, untracked, features))
+        ]
 
     def _proba(self, X):
         """The network's probabilities and the untracked rows of every sequence."""
@@ -152,7 +200,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         with torch_threads(self.n_threads):
             proba = self._raw_proba(data)
         features = data
-        if getattr(self, "max_novelty", None) is None:
+        if getattr(self, "max_novelty", None) is None and self._namer_rule() is None:
             features = [None] * len(data)
         return proba, _untracked(X, data), features
 
@@ -188,9 +236,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             frames are rest (0).
         """
         proba, untracked, features = self._scores(X)
-        return [
-            self._decode(p, rows, x) for p, rows, x in zip(proba, untracked, features)
-        ]
+        return self._decode_all(proba, untracked, features)
 
     def predict_segments(self, X):
         """Gesture instances with their confidence.
@@ -209,8 +255,8 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         """
         proba, untracked, features = self._scores(X)
         return [
-            segments_with_confidence(self._decode(p, rows, x), p, self.classes_)
-            for p, rows, x in zip(proba, untracked, features)
+            segments_with_confidence(labels, p, self.classes_)
+            for labels, p in zip(self._decode_all(proba, untracked, features), proba)
         ]
 
     def score(self, X, y, sample_weight=None):
@@ -289,6 +335,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             "max_lengths": max_lengths,
             "max_novelty": None if max_novelty is None else float(max_novelty),
             "viterbi": viterbi,
+            "namer_weight": float(getattr(self, "namer_weight", 0.0)),
         }
 
     def _fitted_lengths(self, attribute, rule, off):
@@ -308,16 +355,24 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
         return fitted
 
-    def _decode(self, proba, untracked=None, features=None):
+    def _decode(self, proba, untracked=None, features=None, namer=None):
         """Labels of one sequence; ``features`` (its rows as ``fit`` saw them)
-        are read by the ``max_novelty`` rule alone, on the rows of the runs
-        it judges."""
+        are read by the ``max_novelty`` rule and the run namer alone, on the
+        rows of the runs they judge (``namer``: the namer's scores of a run
+        given, ``namer(start, end)``, as :meth:`_decode_all` does)."""
         rules = self._run_rules()
         novelty = None
         if rules["max_novelty"] is not None:
             if features is None:
                 raise ValueError("max_novelty needs the sequence's features")
             novelty = novelty_of(features, self.novelty_.score)
+        score = self._namer_rule()
+        if score is not None and namer is None:
+            if features is None:
+                raise ValueError("the run namer needs the sequence's features")
+            namer = namer_of(features, score)
+        elif score is None:
+            namer = None
         return decode(
             proba,
             self.classes_,
@@ -325,6 +380,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             smoothing=self.smoothing,
             untracked=untracked,
             novelty=novelty,
+            namer=namer,
             **rules,
         )
 
@@ -381,6 +437,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             max_run=max_period,
             owner=f"{type(self).__name__}.smooth_span",
             novelty=None if rules["max_novelty"] is None else self.novelty_.score,
+            namer=self._namer_rule(),
             **rules,
         )
 

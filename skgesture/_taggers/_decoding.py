@@ -16,6 +16,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 
 from skgesture._stream import StreamSegment
+from skgesture._taggers._namer import name_run, namer_of
 from skgesture._taggers._viterbi import ViterbiPath, log_scores
 from skgesture.utils._buffers import RowBuffer
 from skgesture.utils._segments import labels_to_segments, remove_short_runs, runs
@@ -168,12 +169,17 @@ def reject_runs(
     max_lengths=None,
     novelty=None,
     max_novelty=None,
+    namer=None,
+    namer_weight=0.0,
 ):
-    """Set to rest the gesture runs too short or too long for their class, too
-    unsure, or unlike its training poses.
+    """Name every gesture run, then set to rest the runs too short or too long
+    for their class, too unsure, or unlike its training poses.
 
     The last rules of the decoding, applied to every run on its own (so a
-    stream decides a run as soon as it ends): a run of class ``c`` shorter
+    stream decides a run as soon as it ends). With ``namer``, a run first
+    takes the name of :func:`~skgesture._taggers._namer.name_run` (the
+    tagger's and the namer's scores of the run's rows; two touching runs that
+    take one name are one gesture). Then a run of class ``c`` shorter
     than ``min_lengths[c]`` frames, longer than ``max_lengths[c]`` frames,
     whose mean raw probability of ``c`` is below ``min_confidence``, or whose
     median novelty for ``c`` is above ``max_novelty``, becomes rest.
@@ -201,6 +207,12 @@ def reject_runs(
         ``max_novelty`` is set.
     max_novelty : float or None, default=None
         Highest median novelty of a run kept; None keeps every run.
+    namer : callable or None, default=None
+        ``namer(start, end)``: the namer's log mean probabilities of rows
+        ``start .. end - 1`` (:func:`~skgesture._taggers._namer.namer_of`);
+        None keeps the runs' labels.
+    namer_weight : float, default=0.0
+        Weight of the namer's scores against the tagger's, in [0, 1].
 
     Returns
     -------
@@ -226,6 +238,7 @@ def reject_runs(
         and min_lengths is None
         and max_lengths is None
         and max_novelty is None
+        and namer is None
     ):
         return labels
     if max_novelty is not None and novelty is None:
@@ -236,6 +249,9 @@ def reject_runs(
         if v == 0:
             continue
         k = int(np.searchsorted(classes, v))
+        if namer is not None:
+            k = name_run(raw[s:e], namer(s, e), namer_weight)
+            labels[s:e] = classes[k]
         too_short = min_lengths is not None and e - s < min_lengths[k]
         too_long = max_lengths is not None and e - s > max_lengths[k]
         if (
@@ -287,13 +303,16 @@ def apply_run_rules(
     max_lengths=None,
     novelty=None,
     max_novelty=None,
+    namer=None,
+    namer_weight=0.0,
 ):
     """The rules of :func:`decode` that follow the path, on its labels.
 
     Untracked frames become rest, rest gaps of at most ``max_gap`` frames
     between two runs of one class are filled, gesture runs shorter than
     ``min_run`` become rest, untracked frames are rest again, and
-    :func:`reject_runs` judges every run (``raw``: the raw probabilities).
+    :func:`reject_runs` names (with ``namer``) and judges every run (``raw``:
+    the raw probabilities).
 
     Returns
     -------
@@ -316,6 +335,8 @@ def apply_run_rules(
         max_lengths=max_lengths,
         novelty=novelty,
         max_novelty=max_novelty,
+        namer=namer,
+        namer_weight=namer_weight,
     )
 
 
@@ -370,6 +391,8 @@ def decode(
     raw=None,
     novelty=None,
     max_novelty=None,
+    namer=None,
+    namer_weight=0.0,
 ):
     """Per-frame labels of one sequence from its class probabilities.
 
@@ -410,6 +433,11 @@ def decode(
     max_novelty : float or None, default=None
         Gesture runs whose median novelty for their class is higher become
         rest (:func:`reject_runs`).
+    namer : callable or None, default=None
+        ``namer(start, end)``, the run namer's scores of rows ``start .. end
+        - 1``; every gesture run is named with them first (:func:`reject_runs`).
+    namer_weight : float, default=0.0
+        Weight of the namer's scores against the tagger's.
 
     Returns
     -------
@@ -440,6 +468,8 @@ def decode(
         max_lengths=max_lengths,
         novelty=novelty,
         max_novelty=max_novelty,
+        namer=namer,
+        namer_weight=namer_weight,
     )
 
 
@@ -516,7 +546,8 @@ class LabelRuns:
     :func:`skgesture._taggers._decoding.segments_with_confidence`, applied by
     calling those functions on stretches of rows that no later row can
     change: the stream is cut where the labels before and after cannot
-    interact, i.e. between two different gesture labels, before a gesture
+    interact, i.e. between two different gesture labels (but with a
+    ``namer``), before a gesture
     whose preceding rest gap cannot be filled, and inside a rest run longer
     than ``max_gap``. A run of one gesture is therefore emitted once ``max_gap
     + 1`` rest rows follow it (its first rest row for ``max_gap=0``) or
@@ -543,6 +574,16 @@ class LabelRuns:
         novelty of every row too.
     viterbi : ViterbiRule or None, default=None
         The path (:func:`best_path`); None: the arg-max.
+    namer : callable or None, default=None
+        ``namer(rows) -> (n_classes,)``, the run namer's scores of a run's
+        feature rows (:func:`~skgesture._taggers._namer.namer_scores`); with
+        it, :meth:`feed` takes the feature rows too, kept until their
+        stretch is decided, and the stream is not cut between two touching
+        gestures (two touching runs named alike are one gesture, as
+        offline): a gesture followed at once by another is emitted when the
+        second ends.
+    namer_weight : float, default=0.0
+        Weight of the namer (:func:`reject_runs`).
 
     Examples
     --------
@@ -573,8 +614,13 @@ class LabelRuns:
         max_lengths=None,
         viterbi=None,
         max_novelty=None,
+        namer=None,
+        namer_weight=0.0,
     ):
         self.classes = np.asarray(classes)
+        self.namer = namer
+        self.namer_weight = float(namer_weight)
+        self.feature_rows = None  # with a namer: the stretch's feature rows
         self.min_run = int(min_run)
         self.max_gap = int(max_gap)
         self.min_confidence = float(min_confidence)
@@ -598,10 +644,10 @@ class LabelRuns:
         self.start = 0  # its first row
         self.before = 0  # label of the run before it
 
-    def feed(self, lo, smoothed, raw, rest, times, novelty=None):
-        """Rows ``lo ..`` in (smoothed and raw scores, rest flags, times, and
-        with ``max_novelty`` their novelty); the segments of the stretches
-        they close out."""
+    def feed(self, lo, smoothed, raw, rest, times, novelty=None, rows=None):
+        """Rows ``lo ..`` in (smoothed and raw scores, rest flags, times, with
+        ``max_novelty`` their novelty, with ``namer`` their feature rows);
+        the segments of the stretches they close out."""
         smoothed = np.asarray(smoothed)
         rest = np.asarray(rest, dtype=bool)
         if lo != self.fed:
@@ -610,6 +656,13 @@ class LabelRuns:
             if novelty is None:
                 raise ValueError("max_novelty is set: feed the rows' novelty too")
             self.novelty.append(novelty)
+        if self.namer is not None:
+            if rows is None:
+                raise ValueError("namer is set: feed the feature rows too")
+            rows = np.asarray(rows)
+            if self.feature_rows is None:
+                self.feature_rows = RowBuffer(rows.shape[1:], capacity=64)
+            self.feature_rows.append(rows)
         self.fed = lo + len(smoothed)
         self.raw.append(raw, rest)
         self.rest.append(rest)
@@ -633,10 +686,17 @@ class LabelRuns:
             self.n = j + 1
             if lab != self.label:
                 if lab != 0 and (
-                    self.label != 0  # between two different gestures
-                    or self.start <= self.cs  # after a rest run already cut
-                    or j - self.start > gap  # after a long rest gap
-                    or self.before != lab  # between two different classes
+                    # between two different gestures (not with a namer: their
+                    # new names may make them one)
+                    (self.label != 0 and self.namer is None)
+                    or (
+                        self.label == 0
+                        and (
+                            self.start <= self.cs  # after a rest run already cut
+                            or j - self.start > gap  # after a long rest gap
+                            or self.before != lab  # between two different classes
+                        )
+                    )
                 ):
                     self._cut(j, int(times[i]), out)
                 self.before, self.label, self.start = self.label, lab, j
@@ -665,9 +725,11 @@ class LabelRuns:
             return
         if self.gestures:
             raw = self.raw.data(cs, b)
-            novelty = None
+            novelty = namer = None
             if self.max_novelty is not None:
                 novelty = novelty_of(self.novelty.data(cs, b))
+            if self.namer is not None:
+                namer = namer_of(self.feature_rows.data(cs, b), self.namer)
             labels = apply_run_rules(
                 self.labels.data(cs, b),
                 raw,
@@ -680,6 +742,8 @@ class LabelRuns:
                 max_lengths=self.max_lengths,
                 novelty=novelty,
                 max_novelty=self.max_novelty,
+                namer=namer,
+                namer_weight=self.namer_weight,
             )
             for cls, s, e, conf in segments_with_confidence(
                 labels, raw, self.classes
@@ -691,6 +755,8 @@ class LabelRuns:
             buf.drop(b)
         if self.max_novelty is not None:
             self.novelty.drop(b)
+        if self.feature_rows is not None:
+            self.feature_rows.drop(b)
 
     def held(self):
         """Rows of the stretch not yet decided."""

@@ -17,13 +17,15 @@ from skgesture._nn._modules import (
     TemporalConvModule,
 )
 from skgesture._nn._sequence_net import _CropNet, predict_whole
-from skgesture._nn._training import IGNORE_INDEX
+from skgesture._nn._training import IGNORE_INDEX, torch_threads
 from skgesture._taggers._base import (
     _DECODING_CONSTRAINTS,
     _STREAM_CONSTRAINTS,
     _BaseTagger,
 )
+from skgesture._taggers._namer import NAMER_HIDDEN, NAMER_TRAINING, gesture_windows
 from skgesture.utils import PoseNovelty
+from skgesture.utils._fitting import fit_cached, seed_from
 
 __all__ = ["SequenceTagger"]
 
@@ -153,6 +155,24 @@ class SequenceTagger(_BaseTagger):
     viterbi_lag : int, default=6
         Frames between a frame and the path's decision on it (added to the
         stream's delay).
+    namer : {"gru"} or None, default=None
+        ``"gru"``: also train a run namer, a bidirectional GRU (one layer of
+        64 units a direction) on the training gestures alone (each gesture
+        and copies of it with jittered ends; half the tagger's epochs,
+        batches of 32 windows of at most 64 frames), which names every
+        gesture run once it has ended, from all of its frames (see
+        ``namer_weight``). A network with a bounded look-ahead names the
+        first frames of a gesture before its end is seen; the namer reads the
+        end, and the run rules judge a run only once it has ended, so the
+        stream stays exact (a gesture followed at once by another is emitted
+        when the second ends). About 10 s more per fit of the recommended
+        model on 2 cores (docs/design.md, "The run namer"). None: no namer.
+    namer_weight : float, default=0.75
+        Decision parameter of the namer: a run is named by the gesture class
+        with the highest ``(1 - namer_weight) * log(the tagger's mean
+        probability over the run) + namer_weight * log(the namer's)``; two
+        touching runs named alike are one gesture. 0: the runs keep the
+        path's labels (as without a namer); in [0, 1].
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a network reading a window (the TCN, or
@@ -201,6 +221,11 @@ class SequenceTagger(_BaseTagger):
         class's distance, read by ``max_novelty``.
     net_ : skorch.NeuralNet
         The trained network (``net_.history`` holds the losses).
+    namer_ : skorch.NeuralNet
+        With ``namer``: the trained run namer.
+    namer_mean_, namer_scale_ : ndarray of shape (n_features,)
+        With ``namer``: the standardisation of the namer's inputs (the
+        statistics of the training gestures' frames).
     mean_ : ndarray of shape (n_features,)
         Training mean of every feature.
     scale_ : ndarray of shape (n_features,)
@@ -277,6 +302,8 @@ class SequenceTagger(_BaseTagger):
         "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
         "n_iter_no_change": [Interval(Integral, 1, None, closed="left")],
         "lookahead": [Interval(Integral, 0, None, closed="left"), None],
+        "namer": [StrOptions({"gru"}), None],
+        "namer_weight": [Interval(Real, 0, 1, closed="both")],
         **_DECODING_CONSTRAINTS,
         **_STREAM_CONSTRAINTS,
         "memory": [None, str, HasMethods(["cache"])],
@@ -325,6 +352,8 @@ class SequenceTagger(_BaseTagger):
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
+        namer=None,
+        namer_weight=0.75,
         stream_past=32,
         stream_future=8,
         memory=None,
@@ -365,6 +394,8 @@ class SequenceTagger(_BaseTagger):
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag
+        self.namer = namer
+        self.namer_weight = namer_weight
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.memory = memory
@@ -416,7 +447,36 @@ class SequenceTagger(_BaseTagger):
             tracked=[v != IGNORE_INDEX for v in y_idx],
         )
         self._class_weight = _class_weights(self.class_weight, y_idx, len(classes))
-        return self._fit_network([x.astype(np.float32) for x in X], y_idx, classes)
+        X = [x.astype(np.float32) for x in X]
+        self._fit_network(X, y_idx, classes)
+        for name in ("namer_", "namer_mean_", "namer_scale_"):
+            self.__dict__.pop(name, None)  # a refit without a namer
+        if self.namer is not None:
+            self._fit_namer(X, y_idx, classes)
+        return self
+
+    def _fit_namer(self, X, y_idx, classes):
+        """Train the run namer on the training gestures (``namer_``,
+        ``namer_mean_``, ``namer_scale_``), cached by ``memory`` as the
+        tagger's network is."""
+        params = {**self._training_params(), **NAMER_TRAINING}
+        params["max_epochs"] = max(1, self.max_epochs // 2)
+        params["steps_per_epoch"] = self.steps_per_epoch
+        params["early_stopping"] = False  # the namer's schedule is fixed
+        windows, labels = gesture_windows(X, y_idx, seed_from(params["random_state"]))
+        network = _CropNet(
+            n_classes=len(classes),
+            architecture=self.namer,
+            hidden_sizes=NAMER_HIDDEN,
+            augmenter=None if self.augment is None else clone(self.augment),
+            standardize=True,
+            **params,
+        )
+        with torch_threads(self._fit_threads()):
+            fitted = fit_cached(self.memory, network, windows, labels)
+        self.namer_ = fitted.net_
+        self.namer_mean_ = fitted.mean_
+        self.namer_scale_ = fitted.scale_
 
     def _network(self, n_classes):
         return _CropNet(

@@ -254,8 +254,10 @@ class TrailingWindowStream:
         rows (:meth:`skgesture.utils.PoseNovelty.score`), computed
         for each row as it is scored; needed with ``max_novelty``.
     **run_rules : dict
-        ``min_confidence``, ``min_lengths``, ``max_lengths``, ``max_novelty``
-        and ``viterbi`` of :class:`LabelRuns`.
+        ``min_confidence``, ``min_lengths``, ``max_lengths``, ``max_novelty``,
+        ``viterbi``, ``namer`` and ``namer_weight`` of :class:`LabelRuns`
+        (with ``namer``, the feature rows go along with their scores until
+        their run is decided).
 
     Examples
     --------
@@ -306,6 +308,7 @@ class TrailingWindowStream:
         self.X = None
         self.raw = RowBuffer((len(self.classes),), capacity=64)
         self.nov = RowBuffer((len(self.classes),), capacity=64)
+        self.rows = None  # feature rows kept for the namer, scored, undecided
         self.n_out = 0  # frames whose probabilities are computed
         self.last_time = 0
 
@@ -342,6 +345,10 @@ class TrailingWindowStream:
         self.raw.append(p, self.X.mask(u, hi), times)
         if self.novelty is not None:
             self.nov.append(self.novelty(self.X.data(u, hi)))
+        if self.runs.namer is not None:
+            if self.rows is None:
+                self.rows = RowBuffer(self.X.data(u, hi).shape[1:], capacity=64)
+            self.rows.append(self.X.data(u, hi))
         self.n_out = hi
         return self._decide(*self.smoother.step(p, np.asarray(times)))
 
@@ -350,11 +357,20 @@ class TrailingWindowStream:
             return []
         hi = lo + len(smoothed)
         novelty = None if self.novelty is None else self.nov.data(lo, hi)
+        rows = None if self.rows is None else self.rows.data(lo, hi)
         out = self.runs.feed(
-            lo, smoothed, self.raw.data(lo, hi), self.raw.mask(lo, hi), times, novelty
+            lo,
+            smoothed,
+            self.raw.data(lo, hi),
+            self.raw.mask(lo, hi),
+            times,
+            novelty,
+            rows,
         )
         self.raw.drop(hi)
         self.nov.drop(hi)
+        if self.rows is not None:
+            self.rows.drop(hi)
         return out
 
     def held(self):

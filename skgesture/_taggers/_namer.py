@@ -1,0 +1,187 @@
+"""The run namer: a bidirectional network that names each gesture run once it
+has ended.
+
+A tagger whose look-ahead is bounded (the recommended model's causal TCN,
+``lookahead=8``) labels a frame from the frames up to a few after it. Two
+gestures that differ only in how they end (Montalbano's classes 14 and 15,
+the paper's most confused pair) are then told apart only at their end, and
+the first frames of the run carry the wrong name. Once a run has ended,
+though, all of its frames are known: :class:`SequenceTagger` with
+``namer="gru"`` trains a small bidirectional GRU on the training gestures
+alone (each gesture, and copies of it with jittered ends, all its frames
+labelled with its class), and the decoding names every run by the weighted
+sum of the log mean probabilities of the tagger and of this namer read over
+the run's own rows (``namer_weight``, :func:`name_run`). The rule judges a run
+once it has ended, like the other run rules, so the model still streams
+exactly (docs/design.md, "The run namer").
+"""
+
+# SPDX-License-Identifier: BSD-3-Clause
+
+import numpy as np
+
+from skgesture._nn._training import IGNORE_INDEX
+from skgesture.utils._segments import runs
+
+NAMER_COPIES = 4  # training windows per gesture: itself and 3 with jittered ends
+NAMER_JITTER = 0.1  # sd of a jittered end, as a fraction of the gesture's length
+NAMER_HIDDEN = (64,)  # units per direction of the namer's one GRU layer
+# The namer's own training: short windows, larger batches, half the tagger's
+# epochs (its steps per epoch; 300 steps for the recommended model's 600).
+NAMER_TRAINING = {
+    "crop_length": 64,
+    "batch_size": 32,
+    "learning_rate": 3e-3,
+    "dropout": 0.2,
+}
+TINY = 1e-9  # floor of a mean probability before its log
+
+
+def gesture_windows(X, y_idx, seed, copies=NAMER_COPIES, jitter=NAMER_JITTER):
+    """The namer's training data: the rows of every gesture of ``X``.
+
+    Every run of a gesture class in ``y_idx`` (class indices; 0 rest,
+    ``IGNORE_INDEX`` untracked) gives ``copies`` windows: the run itself and
+    ``copies - 1`` with both ends moved by a Gaussian of ``jitter`` times its
+    length (a decoded run's ends are never exactly the true ones), each
+    labelled with the run's class on every tracked row.
+
+    Parameters
+    ----------
+    X : list of ndarray of shape (n_frames_i, n_features)
+        Feature rows.
+    y_idx : list of ndarray of shape (n_frames_i,)
+        Class index of every row.
+    seed : int
+        Seed of the jitter.
+    copies : int, default=4
+    jitter : float, default=0.1
+
+    Returns
+    -------
+    windows : list of ndarray
+    labels : list of ndarray of int64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._namer import gesture_windows
+    >>> X = [np.zeros((10, 2), np.float32)]
+    >>> y = [np.array([0, 0, 2, 2, 2, 2, 0, 0, 0, 0])]
+    >>> W, Y = gesture_windows(X, y, 0, copies=1)
+    >>> [w.shape for w in W], Y[0].tolist()
+    ([(4, 2)], [2, 2, 2, 2])
+    """
+    rng = np.random.default_rng(seed)
+    windows, labels = [], []
+    for x, y in zip(X, y_idx):
+        y = np.asarray(y)
+        starts, ends, values = runs(y)
+        for s, e, v in zip(starts.tolist(), ends.tolist(), values.tolist()):
+            if v <= 0:  # rest, or untracked rows
+                continue
+            n = e - s
+            for copy in range(copies):
+                a, b = s, e
+                if copy:
+                    da, db = np.rint(rng.normal(0.0, jitter * n, 2)).astype(int)
+                    a, b = max(0, s + int(da)), min(len(y), e + int(db))
+                if b - a < 2:
+                    continue
+                windows.append(x[a:b])
+                labels.append(np.where(y[a:b] == IGNORE_INDEX, IGNORE_INDEX, v))
+    return windows, labels
+
+
+def name_run(raw, namer_scores, weight):
+    """Column of the name of one run: the gesture column with the highest
+    ``(1 - weight) * log(mean raw probability) + weight * namer_scores``.
+
+    Parameters
+    ----------
+    raw : ndarray of shape (n_rows, n_classes)
+        The tagger's raw probabilities of the run's rows (rest first).
+    namer_scores : ndarray of shape (n_classes,)
+        The namer's log mean probabilities of the run (:func:`namer_scores`).
+    weight : float
+        Weight of the namer, in [0, 1] (0: the tagger's mean alone).
+
+    Returns
+    -------
+    int
+        A column of ``raw``, never 0 (rest).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._namer import name_run
+    >>> raw = np.array([[0.1, 0.6, 0.3], [0.1, 0.5, 0.4]])
+    >>> namer = np.log([0.01, 0.2, 0.79])
+    >>> name_run(raw, namer, 0.0), name_run(raw, namer, 0.5)
+    (1, 2)
+    """
+    score = (1.0 - weight) * np.log(raw.mean(axis=0) + TINY) + weight * namer_scores
+    score = np.array(score, dtype=np.float64)
+    score[0] = -np.inf
+    return int(np.argmax(score))
+
+
+def namer_scores(module, mean, scale, rows, n_classes):
+    """The namer's log mean probabilities over ``rows`` (one run): the
+    :func:`namer_batch` of one run, as a stream computes it when the run ends.
+
+    Parameters
+    ----------
+    module : RecurrentTaggerModule
+        The namer's network (``SequenceTagger.namer_.module_``).
+    mean, scale : ndarray of shape (n_features,)
+        Its standardisation.
+    rows : ndarray of shape (n_rows, n_features)
+        The run's feature rows.
+    n_classes : int
+
+    Returns
+    -------
+    ndarray of shape (n_classes,)
+    """
+    return namer_batch(module, mean, scale, [rows], n_classes)[0]
+
+
+def namer_batch(module, mean, scale, windows, n_classes):
+    """:func:`namer_scores` of several runs in one packed forward pass.
+
+    Offline, every run of a ``predict`` call is named in one pass (3 times
+    faster than one call a run); the scores equal those of one run at a time
+    to float32 rounding (about 1e-6 in log probability).
+
+    Returns
+    -------
+    ndarray of shape (n_windows, n_classes)
+    """
+    import torch
+    from torch.nn.utils.rnn import pack_sequence, pad_packed_sequence
+
+    if not windows:
+        return np.zeros((0, n_classes))
+    xs = [
+        torch.from_numpy(((np.asarray(w) - mean) / scale).astype(np.float32))
+        for w in windows
+    ]
+    module.eval()
+    with torch.inference_mode():
+        out = pack_sequence(xs, enforce_sorted=False)
+        for k, rnn in enumerate(module.layers):
+            out, _ = rnn(out)
+            if k < len(module.layers) - 1:
+                out = out._replace(data=module.activation(out.data))
+        padded, lengths = pad_packed_sequence(out, batch_first=True)
+        proba = torch.softmax(module.head(padded), dim=-1).double()
+        means = [proba[i, :n].mean(dim=0) for i, n in enumerate(lengths.tolist())]
+    return np.log(torch.stack(means).numpy() + TINY)
+
+
+def namer_of(rows, score):
+    """The ``namer(start, end)`` of :func:`~skgesture._taggers._decoding.reject_runs`:
+    ``score(rows[start:end])``, the same call offline (the sequence's rows)
+    and live (a stream's rows of the stretch being decided)."""
+    return lambda s, e: score(rows[s:e])
