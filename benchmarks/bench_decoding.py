@@ -32,14 +32,17 @@ Protocol
   x min_confidence x min_duration x max_duration x viterbi_penalty x
   max_novelty, 576 settings; max_duration and max_novelty None are no limit,
   viterbi_penalty None the arg-max path; ``viterbi_duration`` stays the
-  tagger's default, 0.7, and ``viterbi_lag`` too, 6, but in ``VARY``; the
+  tagger's default, 0.7, and ``viterbi_lag`` too, 6, and ``namer_weight``,
+  0.25, both in ``VARY``; the
   current default is added when the grid lacks it; ``--vary NAME`` instead
   varies ``NAME`` alone over ``VARY``, the others at the default's values:
   ``--vary viterbi_lag`` gives the Jaccard of every lag, the decoding's share
   of the live delay) the parameters
   are set on the tagger (``tagger.set_params``) and ``tagger._decode(p,
   untracked, novelty)`` gives the labels (``novelty``: the cell's novelty of
-  every frame, read through ``CachedNovelty``), ``segments_with_confidence``
+  every frame, read through ``CachedNovelty``; the run namer's scores of every
+  run that the settings' paths give, computed in the fit (``namer_table``)
+  and read through ``CachedNamer``), ``segments_with_confidence``
   the events; labels go back to the input's frames with ``frames_back``,
   events with ``segments_back`` (as ``GesturePipeline.predict`` /
   ``predict_segments`` do). ``max_gap`` and the
@@ -151,12 +154,14 @@ from skgesture._rate import (  # noqa: E402
     segments_back,
 )
 from skgesture._taggers._decoding import segments_with_confidence  # noqa: E402
+from skgesture._taggers._namer import namer_scores  # noqa: E402
 from skgesture.datasets import (  # noqa: E402
     SyntheticBackground,
     make_background,
     make_gesture_streams,
 )
 from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
+from skgesture.utils import runs  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench_results"
@@ -181,6 +186,7 @@ PARAMS = (
     "viterbi_penalty",
     "max_novelty",
     "viterbi_lag",
+    "namer_weight",
 )
 GRID = {
     "smooth_span": (1, 5),
@@ -197,6 +203,7 @@ VARY = {
     **GRID,
     "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0),
     "viterbi_lag": (0, 1, 2, 3, 4, 6, 8),
+    "namer_weight": (0.0, 0.1, 0.25, 0.4, 0.5, 0.75, 1.0),  # 0: no renaming
 }
 QUICK_GRID = {
     "smooth_span": (1, 5),
@@ -355,9 +362,59 @@ def model_rate_proba(model, X, rates):
             np.asarray(p, dtype=PROBA_DTYPE),
             np.asarray(u, dtype=bool),
             np.asarray(tagger.novelty_.score(f), dtype=PROBA_DTYPE),
+            *namer_table(tagger, p, u, f),
         )
         for p, u, f in zip(proba, untracked, F)
     ]
+
+
+def path_settings():
+    """The settings of ``GRID`` and ``VARY`` that move the runs the run
+    rules judge (smoothing, path, ``min_run``), the others at the default."""
+    default = current_default()
+    moving = ("smooth_span", "min_run", "viterbi_penalty", "viterbi_lag")
+    grid = [dict(zip(moving, v)) for v in itertools.product(
+        *[GRID.get(p, (default[p],)) for p in moving])]  # fmt: skip
+    vary = [{p: v} for p in moving for v in VARY.get(p, ())]
+    out = []
+    for setting in grid + vary:
+        full = {p: setting.get(p, default[p]) for p in moving}
+        if full not in out:
+            out.append(full)
+    return out
+
+
+def namer_table(tagger, proba, untracked, features):
+    """The run namer's scores of every run that a setting of
+    :func:`path_settings` gives (the rules that judge runs off): ``(spans,
+    scores)``, ``(n_runs, 2)`` start and end rows and ``(n_runs, n_classes)``
+    scores (:func:`skgesture._taggers._namer.namer_scores`), empty without a
+    namer; :class:`CachedNamer` reads them back."""
+    n_classes = len(tagger.classes_)
+    if getattr(tagger, "namer_", None) is None:
+        return np.zeros((0, 2), np.int32), np.zeros((0, n_classes), PROBA_DTYPE)
+    saved = tagger.get_params()
+    rows = np.asarray(features, dtype=np.float64)
+    p = np.asarray(proba, dtype=np.float64)
+    spans = set()
+    try:
+        tagger.set_params(min_confidence=0.0, min_duration=0.0, max_duration=None,
+                          max_novelty=None, namer_weight=0.0)  # fmt: skip
+        for setting in path_settings():
+            tagger.set_params(**setting)
+            starts, ends, values = runs(tagger._decode(p, untracked))
+            spans |= {(s, e) for s, e, v in zip(starts, ends, values) if v != 0}
+    finally:
+        tagger.set_params(**saved)
+    spans = np.array(sorted(spans), dtype=np.int32).reshape(-1, 2)
+    module = tagger.namer_.module_
+    scores = [
+        namer_scores(
+            module, tagger.namer_mean_, tagger.namer_scale_, rows[s:e], n_classes
+        )
+        for s, e in spans.tolist()
+    ]
+    return spans, np.asarray(scores, dtype=PROBA_DTYPE).reshape(-1, n_classes)
 
 
 def fit_cell(make, X_tr, y_tr, X_te, rate, negatives):
@@ -425,9 +482,10 @@ def save_cell(path, cell):
         (f"neg{k}", cell["negatives"][n]) for k, n in enumerate(cell["negatives"])
     ]
     for prefix, rows in parts:
-        for i, (p, u, n) in enumerate(rows):
+        for i, (p, u, n, ms, mv) in enumerate(rows):
             arrays[f"{prefix}_p{i}"], arrays[f"{prefix}_u{i}"] = p, u
             arrays[f"{prefix}_n{i}"] = n
+            arrays[f"{prefix}_ms{i}"], arrays[f"{prefix}_mv{i}"] = ms, mv
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
     with open(tmp, "wb") as fh:
@@ -443,7 +501,7 @@ def load_cell(path):
         def rows(prefix):
             n = sum(1 for k in f.files if k.startswith(f"{prefix}_p"))
             return [
-                (f[f"{prefix}_p{i}"], f[f"{prefix}_u{i}"], f[f"{prefix}_n{i}"])
+                tuple(f[f"{prefix}_{a}{i}"] for a in ("p", "u", "n", "ms", "mv"))
                 for i in range(n)
             ]
 
@@ -491,6 +549,28 @@ def decoder(make, meta):
     return tagger
 
 
+class CachedNamer:
+    """Stands in for a fitted tagger's run namer in :func:`decode_back`: the
+    scores of :func:`namer_table` looked up by the run's rows, which
+    :func:`decode_back` gives as the cell's novelty with each row's index in
+    a last column."""
+
+    def __init__(self, spans, scores):
+        self.table = {
+            (int(s), int(e)): np.asarray(v, dtype=np.float64)
+            for (s, e), v in zip(spans, scores)
+        }
+
+    def score(self, rows):
+        span = (int(rows[0, -1]), int(rows[-1, -1]) + 1)
+        if span not in self.table:
+            raise KeyError(
+                f"no cached namer scores for the run of rows {span}: a decoding "
+                "setting outside path_settings(); refit the cell"
+            )
+        return self.table[span]
+
+
 class CachedNovelty:
     """Stands in for a fitted tagger's ``novelty_`` in :func:`decode_back`:
     the "features" it is given are the cell's novelty of every frame for
@@ -502,10 +582,16 @@ class CachedNovelty:
         return rows if k is None else rows[:, k]
 
 
-def decode_back(tagger, proba, untracked, novelty, rate, fps, n_frames):
-    """Labels and events ``(class, start, end, confidence)`` in input frames."""
+def decode_back(tagger, cached, rate, fps, n_frames):
+    """Labels and events ``(class, start, end, confidence)`` in input frames
+    of one cached sequence ``(proba, untracked, novelty, spans, scores)``."""
+    proba, untracked, novelty, spans, scores = cached
     p = np.asarray(proba, dtype=np.float64)  # as predict decodes them
-    labels = tagger._decode(p, untracked, novelty)
+    rows = np.column_stack([novelty, np.arange(len(p))])  # + each row's index
+    namer = CachedNamer(spans, scores)
+    weight = float(getattr(tagger, "namer_weight", 0.0))
+    tagger._namer_rule = lambda: namer.score if len(spans) and weight > 0 else None
+    labels = tagger._decode(p, untracked, rows)
     segs = segments_with_confidence(labels, p, tagger.classes_)
     if rate is None or same_rate(rate, fps):
         return labels, segs
@@ -528,8 +614,8 @@ def score_cell(cell, tagger, settings, y_te, truth, negatives):
     for setting in settings:
         tagger.set_params(**setting)
         decoded = [
-            decode_back(tagger, p, u, n, rate, fps, len(y))
-            for (p, u, n), y in zip(cell["test"], y_te)
+            decode_back(tagger, c, rate, fps, len(y))
+            for c, y in zip(cell["test"], y_te)
         ]
         score = {"jaccard": float(jaccard_index(y_te, [d[0] for d in decoded]))}
         if truth is not None:
@@ -538,8 +624,8 @@ def score_cell(cell, tagger, settings, y_te, truth, negatives):
             score.update(found=float(recall * n) if n else 0.0, gestures=n)
         score["events"] = {
             name: sum(
-                len(decode_back(tagger, p, u, n, f, fps, len(x))[1])
-                for (p, u, n), x, f in zip(
+                len(decode_back(tagger, c, f, fps, len(x))[1])
+                for c, x, f in zip(
                     cell["negatives"][name], negatives[name].X, negatives[name].fps
                 )
             )

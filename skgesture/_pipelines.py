@@ -30,6 +30,7 @@ MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short ges
 MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
 VITERBI_PENALTY = 5.0  # the duration-aware path: nats to enter a gesture
 MAX_NOVELTY = 1.75  # runs whose poses are this far from their class's are rest
+NAMER_WEIGHT = 0.75  # the run namer's share of a run's name (docs/design.md)
 BACKGROUND_SEQUENCES = 12  # synthetic negatives made at every fit (background=)
 
 # docs/method.md §6.3
@@ -231,12 +232,14 @@ def make_recommended(
 ):
     """The model we recommend: a temporal convolutional tagger that streams exactly.
 
-    ``PoseDescriptor -> SequenceTagger(architecture="tcn", lookahead=8)``: the
-    paper's pose descriptor of every frame, read by a three-stage dilated
-    temporal convolutional network (32 channels, 8 layers a stage, a smoothing
-    loss; Farha & Gall's MS-TCN) whose convolutions are causal and whose output
-    for a frame is read 8 frames later, trained with AdamW and a warm-up cosine
-    schedule on augmented 256-frame crops (time warp, noise). What it predicts
+    ``PoseDescriptor -> SequenceTagger(architecture="tcn", lookahead=8,
+    namer="gru")``: the paper's pose descriptor of every frame, read by a
+    three-stage dilated temporal convolutional network (32 channels, 8 layers a
+    stage, a smoothing loss; Farha & Gall's MS-TCN) whose convolutions are
+    causal and whose output for a frame is read 8 frames later, trained with
+    AdamW and a warm-up cosine schedule on augmented 256-frame crops (time
+    warp, noise); a small bidirectional GRU trained on the gestures alone
+    names every run once it has ended (the run namer). What it predicts
     offline is what :class:`~skgesture.streaming.StreamingRecognizer` gives
     live, to the frame, so an offline benchmark of it is the live robot's.
 
@@ -288,7 +291,8 @@ def make_recommended(
         (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``,
         ``tagger__min_confidence``, ``tagger__min_duration``,
         ``tagger__max_duration``, ``tagger__max_novelty``,
-        ``tagger__viterbi_penalty``) can be searched without retraining.
+        ``tagger__viterbi_penalty``, ``tagger__namer_weight``) can be
+        searched without retraining.
     random_state : int, RandomState instance or None, default=None
         Seeds the network, the crops, the augmentation and the background.
     verbose : int, default=0
@@ -315,7 +319,10 @@ def make_recommended(
     training poses of its class (``tagger__max_novelty=1.75``: the median
     distance of its frames to the nearest training frame of the class, in
     units of how far a held-out training sequence's gestures lie; it removes
-    a fifth of the false events on everyday motion at no measured cost). A
+    a fifth of the false events on everyday motion at no measured cost).
+    Before those rules, every run is named by the tagger's and the run
+    namer's mean probabilities over its frames (``tagger__namer_weight=0.75``,
+    the namer's share; docs/design.md, "The run namer"). A
     confidence floor
     (``tagger__min_confidence``) is left at 0: the floor that suits one
     dataset costs another much (docs/safety.md,
@@ -363,6 +370,8 @@ def make_recommended(
         max_duration=MAX_DURATION,
         max_novelty=MAX_NOVELTY,
         viterbi_penalty=VITERBI_PENALTY,
+        namer="gru",
+        namer_weight=NAMER_WEIGHT,
         fit_threads="all",
         memory=memory,
         device=device,
