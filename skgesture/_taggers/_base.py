@@ -179,7 +179,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                 runs.append((i, s, e))
                 return np.zeros(n_classes)
 
-            self._decode(*args, namer=record)
+            self._decode(*args, namer=record, judge=False)
         table = dict(zip(runs, batch([features[i][s:e] for i, s, e in runs])))
         return [
             self._decode(*args, namer=lambda s, e, i=i: table[(i, s, e)])
@@ -355,12 +355,18 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
         return fitted
 
-    def _decode(self, proba, untracked=None, features=None, namer=None):
+    def _decode(self, proba, untracked=None, features=None, namer=None, judge=True):
         """Labels of one sequence; ``features`` (its rows as ``fit`` saw them)
         are read by the ``max_novelty`` rule and the run namer alone, on the
         rows of the runs they judge (``namer``: the namer's scores of a run
-        given, ``namer(start, end)``, as :meth:`_decode_all` does)."""
+        given, ``namer(start, end)``, as :meth:`_decode_all` does; ``judge``
+        False: the runs are named but no rule judges them, the first pass of
+        :meth:`_decode_all`)."""
         rules = self._run_rules()
+        if not judge:
+            rules.update(
+                min_confidence=0.0, min_lengths=None, max_lengths=None, max_novelty=None
+            )
         novelty = None
         if rules["max_novelty"] is not None:
             if features is None:
