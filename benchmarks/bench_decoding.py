@@ -386,7 +386,7 @@ def path_settings():
 
 def namer_table(tagger, proba, untracked, features):
     """The run namer's scores of every run that a setting of
-    :func:`path_settings` gives (the rules that judge runs off): ``(spans,
+    :func:`path_settings` gives (``tagger._path``, the runs the rules judge): ``(spans,
     scores)``, ``(n_runs, 2)`` start and end rows and ``(n_runs, n_classes)``
     scores (:func:`skgesture._taggers._namer.namer_scores`), empty without a
     namer; :class:`CachedNamer` reads them back."""
@@ -398,11 +398,9 @@ def namer_table(tagger, proba, untracked, features):
     p = np.asarray(proba, dtype=np.float64)
     spans = set()
     try:
-        tagger.set_params(min_confidence=0.0, min_duration=0.0, max_duration=None,
-                          max_novelty=None, namer_weight=0.0)  # fmt: skip
         for setting in path_settings():
             tagger.set_params(**setting)
-            starts, ends, values = runs(tagger._decode(p, untracked))
+            starts, ends, values = runs(tagger._path(p, untracked))
             spans |= {(s, e) for s, e, v in zip(starts, ends, values) if v != 0}
     finally:
         tagger.set_params(**saved)

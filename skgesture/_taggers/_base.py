@@ -30,14 +30,16 @@ from skgesture._taggers._decoding import (
     SMOOTHINGS,
     ViterbiRule,
     class_lengths,
-    decode,
     novelty_of,
+    path_runs,
+    reject_runs,
     segments_with_confidence,
 )
 from skgesture._taggers._namer import namer_batch, namer_of, namer_scores
 from skgesture._taggers._stream import TrailingWindowStream
 from skgesture._taggers._viterbi import chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
+from skgesture.utils._segments import runs
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -166,25 +168,20 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
 
     def _decode_all(self, proba, untracked, features):
         """:meth:`_decode` of every sequence; the run namer names the runs of
-        all of them in one batch: a first pass records the runs it is asked
-        for, then every sequence is decoded with their scores."""
+        all of them in one batch (:func:`~skgesture._taggers._namer.namer_batch`)."""
+        labels = [self._path(p, u) for p, u in zip(proba, untracked)]
+        namers = [None] * len(labels)
         batch = self._namer_rule(batch=True)
-        if batch is None:
-            return [self._decode(*args) for args in zip(proba, untracked, features)]
-        n_classes = len(self.classes_)
-        runs = []
-        for i, args in enumerate(zip(proba, untracked, features)):
-
-            def record(s, e, i=i):
-                runs.append((i, s, e))
-                return np.zeros(n_classes)
-
-            self._decode(*args, namer=record, judge=False)
-        table = dict(zip(runs, batch([features[i][s:e] for i, s, e in runs])))
-        return [
-            self._decode(*args, namer=lambda s, e, i=i: table[(i, s, e)])
-            for i, args in enumerate(zip(proba, untracked, features))
-        ]
+        if batch is not None:
+            spans = [
+                (i, s, e)
+                for i, lab in enumerate(labels)
+                for s, e, v in zip(*runs(lab))
+                if v != 0
+            ]
+            table = dict(zip(spans, batch([features[i][s:e] for i, s, e in spans])))
+            namers = [lambda s, e, i=i: table[(i, s, e)] for i in range(len(labels))]
+        return [self._judge(*args) for args in zip(labels, proba, features, namers)]
 
     def _proba(self, X):
         """The network's probabilities and the untracked rows of every sequence."""
@@ -355,39 +352,54 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             )
         return fitted
 
-    def _decode(self, proba, untracked=None, features=None, namer=None, judge=True):
+    def _decode(self, proba, untracked=None, features=None):
         """Labels of one sequence; ``features`` (its rows as ``fit`` saw them)
         are read by the ``max_novelty`` rule and the run namer alone, on the
-        rows of the runs they judge (``namer``: the namer's scores of a run
-        given, ``namer(start, end)``, as :meth:`_decode_all` does; ``judge``
-        False: the runs are named but no rule judges them, the first pass of
-        :meth:`_decode_all`)."""
+        rows of the runs they judge."""
+        return self._judge(self._path(proba, untracked), proba, features)
+
+    def _path(self, proba, untracked=None):
+        """The runs the run rules judge (:func:`decode`'s path and first rules)."""
         rules = self._run_rules()
-        if not judge:
-            rules.update(
-                min_confidence=0.0, min_lengths=None, max_lengths=None, max_novelty=None
-            )
+        return path_runs(
+            proba,
+            self.classes_,
+            smooth_span=self.smooth_span,
+            smoothing=self.smoothing,
+            min_run=rules["min_run"],
+            max_gap=rules["max_gap"],
+            untracked=untracked,
+            viterbi=rules["viterbi"],
+        )
+
+    def _judge(self, labels, proba, features=None, namer=None):
+        """The run rules on the runs of :meth:`_path` (``namer``: the namer's
+        scores of a run given, ``namer(start, end)``, as :meth:`_decode_all`
+        does; None: computed from ``features``)."""
+        rules = self._run_rules()
         novelty = None
         if rules["max_novelty"] is not None:
             if features is None:
                 raise ValueError("max_novelty needs the sequence's features")
             novelty = novelty_of(features, self.novelty_.score)
         score = self._namer_rule()
-        if score is not None and namer is None:
+        if score is None:
+            namer = None
+        elif namer is None:
             if features is None:
                 raise ValueError("the run namer needs the sequence's features")
             namer = namer_of(features, score)
-        elif score is None:
-            namer = None
-        return decode(
+        return reject_runs(
+            labels,
             proba,
             self.classes_,
-            smooth_span=self.smooth_span,
-            smoothing=self.smoothing,
-            untracked=untracked,
+            min_confidence=rules["min_confidence"],
+            min_lengths=rules["min_lengths"],
+            max_lengths=rules["max_lengths"],
             novelty=novelty,
+            max_novelty=rules["max_novelty"],
             namer=namer,
-            **rules,
+            namer_weight=rules["namer_weight"],
         )
 
     def __sklearn_tags__(self):

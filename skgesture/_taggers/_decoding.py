@@ -319,15 +319,8 @@ def apply_run_rules(
     ndarray of shape (n_frames,)
         A filtered copy of ``labels``.
     """
-    labels = np.array(labels, copy=True)
-    if untracked is not None and np.any(untracked):
-        labels[untracked] = 0
-    labels = fill_short_gaps(labels, max_gap)
-    labels = remove_short_runs(labels, min_run)
-    if untracked is not None and np.any(untracked):
-        labels[untracked] = 0
     return reject_runs(
-        labels,
+        prepare_runs(labels, untracked=untracked, min_run=min_run, max_gap=max_gap),
         raw,
         classes,
         min_confidence=min_confidence,
@@ -338,6 +331,52 @@ def apply_run_rules(
         namer=namer,
         namer_weight=namer_weight,
     )
+
+
+def prepare_runs(labels, *, untracked=None, min_run=1, max_gap=0):
+    """The first rules of :func:`apply_run_rules`, which give the runs that
+    :func:`reject_runs` judges: untracked frames become rest, rest gaps of at
+    most ``max_gap`` frames between two runs of one class are filled, gesture
+    runs shorter than ``min_run`` become rest, untracked frames are rest
+    again.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        A filtered copy of ``labels``.
+    """
+    labels = np.array(labels, copy=True)
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    labels = fill_short_gaps(labels, max_gap)
+    labels = remove_short_runs(labels, min_run)
+    if untracked is not None and np.any(untracked):
+        labels[untracked] = 0
+    return labels
+
+
+def path_runs(
+    proba,
+    classes,
+    *,
+    smooth_span=1,
+    smoothing="loess",
+    min_run=1,
+    max_gap=0,
+    untracked=None,
+    viterbi=None,
+):
+    """The runs that :func:`decode` judges: the path of the smoothed
+    probabilities (:func:`best_path`) with the rules of :func:`prepare_runs`.
+
+    Returns
+    -------
+    ndarray of shape (n_frames,)
+        Labels from ``classes``.
+    """
+    smoothed = smooth_proba(proba, smooth_span, smoothing)
+    labels = best_path(smoothed, classes, untracked=untracked, viterbi=viterbi)
+    return prepare_runs(labels, untracked=untracked, min_run=min_run, max_gap=max_gap)
 
 
 def novelty_of(rows, score=None):
@@ -454,15 +493,20 @@ def decode(
     >>> decode(p, np.array([0, 5]), min_run=5).tolist()
     [0, 0, 0, 0, 0, 0, 0, 0]
     """
-    smoothed = smooth_proba(proba, smooth_span, smoothing)
-    labels = best_path(smoothed, classes, untracked=untracked, viterbi=viterbi)
-    return apply_run_rules(
+    labels = path_runs(
+        proba,
+        classes,
+        smooth_span=smooth_span,
+        smoothing=smoothing,
+        min_run=min_run,
+        max_gap=max_gap,
+        untracked=untracked,
+        viterbi=viterbi,
+    )
+    return reject_runs(
         labels,
         proba if raw is None else raw,
         classes,
-        untracked=untracked,
-        min_run=min_run,
-        max_gap=max_gap,
         min_confidence=min_confidence,
         min_lengths=min_lengths,
         max_lengths=max_lengths,
