@@ -241,3 +241,15 @@ def test_namer_weight_is_validated():
         SequenceTagger(namer="gru", namer_weight=1.5).fit(X, y)
     with pytest.raises(ValueError, match="namer"):
         SequenceTagger(namer="tcn").fit(X, y)
+
+
+def test_the_decoding_imports_no_torch():
+    # the numpy decoding (offline and live) reads the namer's module without torch
+    import subprocess
+    import sys
+
+    code = "import sys, skgesture._taggers._decoding; print('torch' in sys.modules)"
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
+    assert out.stdout.strip() == "False"

@@ -20,7 +20,6 @@ exactly (docs/design.md, "The run namer").
 
 import numpy as np
 
-from skgesture._nn._training import IGNORE_INDEX
 from skgesture.utils._segments import runs
 
 NAMER_COPIES = 4  # training windows per gesture: itself and 3 with jittered ends
@@ -72,6 +71,9 @@ def gesture_windows(X, y_idx, seed, copies=NAMER_COPIES, jitter=NAMER_JITTER):
     >>> [w.shape for w in W], Y[0].tolist()
     ([(4, 2)], [2, 2, 2, 2])
     """
+    # (imported here: the decoding, which imports this module, needs no torch)
+    from skgesture._nn._training import IGNORE_INDEX
+
     rng = np.random.default_rng(seed)
     windows, labels = [], []
     for x, y in zip(X, y_idx):
