@@ -161,25 +161,35 @@ def namer_batch(module, mean, scale, windows, n_classes):
     ndarray of shape (n_windows, n_classes)
     """
     import torch
-    from torch.nn.utils.rnn import pack_sequence, pad_packed_sequence
+    from torch.nn.utils.rnn import PackedSequence
 
     if not windows:
         return np.zeros((0, n_classes))
-    xs = [
-        torch.from_numpy(((np.asarray(w) - mean) / scale).astype(np.float32))
-        for w in windows
-    ]
+    lengths = np.array([len(w) for w in windows])
+    # Packed layout built directly (no padded copy): windows sorted longest
+    # first; row t of the window ranked r sits at ``first[t] + r``.
+    order = np.argsort(-lengths, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    batch_sizes = len(lengths) - np.cumsum(np.bincount(lengths))[:-1]  # longer than t
+    first = np.concatenate([[0], np.cumsum(batch_sizes)[:-1]])
+    where = np.concatenate([first[:n] + r for n, r in zip(lengths, rank)])
+    packed = np.empty((len(where), len(mean)), dtype=np.float32)
+    packed[where] = np.concatenate(windows)
+    packed -= np.asarray(mean, dtype=np.float32)  # standardised in place
+    packed /= np.asarray(scale, dtype=np.float32)
     module.eval()
     with torch.inference_mode():
-        out = pack_sequence(xs, enforce_sorted=False)
+        out = PackedSequence(torch.from_numpy(packed), torch.from_numpy(batch_sizes))
         for k, rnn in enumerate(module.layers):
             out, _ = rnn(out)
             if k < len(module.layers) - 1:
                 out = out._replace(data=module.activation(out.data))
-        padded, lengths = pad_packed_sequence(out, batch_first=True)
-        proba = torch.softmax(module.head(padded), dim=-1).double()
-        means = [proba[i, :n].mean(dim=0) for i, n in enumerate(lengths.tolist())]
-    return np.log(torch.stack(means).numpy() + TINY)
+        proba = torch.softmax(module.head(out.data), dim=-1).numpy()
+    sums = np.add.reduceat(
+        proba[where].astype(np.float64), np.cumsum(lengths) - lengths
+    )
+    return np.log(sums / lengths[:, None] + TINY)
 
 
 def namer_of(rows, score):
