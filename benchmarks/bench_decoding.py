@@ -32,8 +32,8 @@ Protocol
   x min_confidence x min_duration x max_duration x viterbi_penalty x
   max_novelty, 576 settings; max_duration and max_novelty None are no limit,
   viterbi_penalty None the arg-max path; ``viterbi_duration`` stays the
-  tagger's default, 0.7, and ``viterbi_lag`` too, 6, and ``namer_weight``,
-  0.25, both in ``VARY``; the
+  tagger's default, 0.7, and ``viterbi_lag`` too, 6, ``namer_weight``,
+  0.75, and ``max_namer_rest``, all in ``VARY``; the
   current default is added when the grid lacks it; ``--vary NAME`` instead
   varies ``NAME`` alone over ``VARY``, the others at the default's values:
   ``--vary viterbi_lag`` gives the Jaccard of every lag, the decoding's share
@@ -187,6 +187,7 @@ PARAMS = (
     "max_novelty",
     "viterbi_lag",
     "namer_weight",
+    "max_namer_rest",
 )
 GRID = {
     "smooth_span": (1, 5),
@@ -204,6 +205,8 @@ VARY = {
     "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0),
     "viterbi_lag": (0, 1, 2, 3, 4, 6, 8),
     "namer_weight": (0.0, 0.1, 0.25, 0.4, 0.5, 0.75, 1.0),  # 0: no renaming
+    # None: the namer's rest is not read
+    "max_namer_rest": (None, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.8),
 }
 QUICK_GRID = {
     "smooth_span": (1, 5),
@@ -442,6 +445,7 @@ def fit_cell(make, X_tr, y_tr, X_te, rate, negatives):
         "fit_s": fit_s,
         "proba_s": time.perf_counter() - t0,
         "negatives": list(neg),
+        "namer_rest": getattr(tagger, "namer_rest_", None),
     }
     return {"meta": meta, "test": test, "negatives": neg}
 
@@ -535,15 +539,18 @@ def current_default():
 def decoder(make, meta):
     """The tagger of ``make()`` with the fitted state its decoding reads.
 
-    ``_decode`` needs ``classes_``, ``class_lengths_`` and
-    ``class_long_lengths_`` of the fitted tagger (skgesture/_taggers/_base.py),
-    all in the cell, so a cached fit decodes without its network.
+    ``_decode`` needs ``classes_``, ``class_lengths_``,
+    ``class_long_lengths_`` and (with the namer's rest rule) ``namer_rest_``
+    of the fitted tagger (skgesture/_taggers/_base.py), all in the cell, so a
+    cached fit decodes without its network.
     """
     tagger = make().named_steps["tagger"]
     tagger.classes_ = np.asarray(meta["classes"])
     tagger.class_lengths_ = np.asarray(meta["class_lengths"], dtype=float)
     tagger.class_long_lengths_ = np.asarray(meta["class_long_lengths"], dtype=float)
     tagger.novelty_ = CachedNovelty()
+    if meta.get("namer_rest") is not None:
+        tagger.namer_rest_ = int(meta["namer_rest"])
     return tagger
 
 
@@ -587,8 +594,10 @@ def decode_back(tagger, cached, rate, fps, n_frames):
     p = np.asarray(proba, dtype=np.float64)  # as predict decodes them
     rows = np.column_stack([novelty, np.arange(len(p))])  # + each row's index
     namer = CachedNamer(spans, scores)
-    weight = float(getattr(tagger, "namer_weight", 0.0))
-    tagger._namer_rule = lambda: namer.score if len(spans) and weight > 0 else None
+    used = float(getattr(tagger, "namer_weight", 0.0)) > 0 or (
+        getattr(tagger, "max_namer_rest", None) is not None
+    )
+    tagger._namer_rule = lambda: namer.score if len(spans) and used else None
     labels = tagger._decode(p, untracked, rows)
     segs = segments_with_confidence(labels, p, tagger.classes_)
     if rate is None or same_rate(rate, fps):
@@ -1043,7 +1052,7 @@ def main(argv=None):
         unknown = [p for p in comma_list(args.vary) if p not in VARY]
         if unknown:
             parser.error(f"--vary: unknown parameters {unknown}; use {list(PARAMS)}")
-        values = QUICK_GRID if args.quick else VARY
+        values = {**VARY, **QUICK_GRID} if args.quick else VARY
         grid = {p: values[p] for p in comma_list(args.vary)}
     rows = run(
         quick=args.quick,

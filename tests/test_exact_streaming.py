@@ -408,3 +408,22 @@ def test_named_runs_stream_exactly():
         got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
         assert_array_equal(got, segments[:, :3].astype(int))
         assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
+    # the namer's rest rule too, at a limit that removes some events
+    from skgesture._taggers._namer import namer_scores
+
+    tagger = pipe[-1]
+    args = (tagger.namer_.module_, tagger.namer_mean_, tagger.namer_scale_)
+    rest = [
+        np.exp(namer_scores(*args, f[int(s) : int(e)], len(tagger.classes_))[0])
+        for f, segments in zip(F, named)
+        for _, s, e, _ in segments
+    ]
+    rest = np.sort(rest)  # a limit halfway between two runs' rest
+    middle = len(rest) // 2
+    pipe.set_params(tagger__max_namer_rest=float(rest[middle - 1 : middle + 1].mean()))
+    judged = pipe[-1].predict_segments(F)
+    assert 0 < sum(map(len, judged)) < sum(map(len, named))
+    for x, segments in zip(X, judged):
+        events = StreamingRecognizer(pipe).recognize(x)
+        got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
+        assert_array_equal(got, segments[:, :3].astype(int))

@@ -28,8 +28,11 @@ from skgesture._taggers._namer import (  # noqa: E402
     gesture_windows,
     name_run,
     namer_of,
+    namer_scores,
+    rest_windows,
 )
 from skgesture.metrics import jaccard_index  # noqa: E402
+from skgesture.utils._segments import runs  # noqa: E402
 
 # -- the pieces ----------------------------------------------------------------
 
@@ -52,6 +55,32 @@ def test_gesture_windows_are_the_gestures_with_jittered_ends():
         assert set(v[rows != 11].tolist()) <= {1, 2}
     again = gesture_windows(X, [y], seed=0, copies=30, jitter=0.2)
     assert all(np.array_equal(a, b) for a, b in zip(W, again[0]))
+
+
+def test_rest_windows_lie_in_rest_runs_with_gesture_lengths():
+    y = np.array([0] * 10 + [1] * 5 + [0] * 2 + [IGNORE_INDEX] * 3 + [0] * 20)
+    X = [np.arange(len(y), dtype=np.float32)[:, None], np.zeros((6, 1))]
+    W, Y = rest_windows(X, [y, np.zeros(6, dtype=int)], [4, 8, 30], 200, seed=0)
+    assert len(W) == len(Y) == 200
+    rest = set(range(10)) | set(range(20, 40))
+    for w, v in zip(W, Y):
+        assert len(w) == len(v) and v.tolist() == [0] * len(v)
+        if len(w) and w[0, 0] > 0:  # a window of the first sequence
+            rows = w[:, 0].astype(int)
+            # in one rest run: never the gesture, the untracked rows, nor the
+            # 2-row run (shorter than MIN_REST)
+            assert set(rows.tolist()) <= rest
+            assert (rows < 10).all() or (rows >= 20).all()
+            assert np.all(np.diff(rows) == 1)
+    # lengths are the given ones, capped at the run's
+    assert {len(w) for w in W} <= {4, 6, 8, 10, 20}
+    assert {4, 8, 20} <= {len(w) for w in W}
+    # seeded; no rest, no length or no count: no window
+    again = rest_windows(X, [y, np.zeros(6, dtype=int)], [4, 8, 30], 200, seed=0)
+    assert all(np.array_equal(a, b) for a, b in zip(W, again[0]))
+    assert rest_windows(X[:1], [np.ones(len(y), dtype=int)], [4], 5, 0) == ([], [])
+    assert rest_windows(X, [y, y[:6]], [], 5, 0) == ([], [])
+    assert rest_windows(X, [y, y[:6]], [4], 0, 0) == ([], [])
 
 
 def test_a_run_is_named_by_the_weighted_scores_never_rest():
@@ -94,8 +123,30 @@ def test_reject_runs_names_every_run_and_touching_runs_named_alike_join():
     assert short.tolist() == [0] * 9 + [1, 1, 0]
 
 
-@pytest.mark.parametrize("viterbi", [None, ViterbiRule([1, 3, 3, 3], 2.0, 3)])
-def test_the_stream_names_runs_as_offline(viterbi):
+def test_a_run_the_namer_calls_rest_becomes_rest():
+    labels = np.array([0, 1, 1, 1, 0, 2, 2, 2, 0])
+    raw = np.full((len(labels), 4), 0.25)
+    rows = np.zeros((len(labels), 4))
+    rows[1:4, 0] = 1.0  # the namer's rest for the first run
+    rows[5:8, 2] = 1.0
+    rest = np.exp(_scores(rows[1:4])[0])  # its mean probability of rest
+    assert 0.5 < rest < 0.99
+    kwargs = {"namer": namer_of(rows, _scores), "namer_weight": 0.0}
+    for limit, want in [
+        (None, labels),  # not read
+        (rest + 0.01, labels),  # below the limit: kept, as labelled (weight 0)
+        (rest - 0.01, [0, 0, 0, 0, 0, 2, 2, 2, 0]),
+        (0.001, [0] * 9),
+    ]:
+        got = reject_runs(labels, raw, np.arange(4), max_namer_rest=limit, **kwargs)
+        assert got.tolist() == list(want)
+
+
+@pytest.mark.parametrize(
+    "viterbi, max_rest",
+    [(None, None), (ViterbiRule([1, 3, 3, 3], 2.0, 3), None), (None, 0.3)],
+)
+def test_the_stream_names_runs_as_offline(viterbi, max_rest):
     rng = np.random.default_rng(0)
     T = 400
     truth = np.zeros(T, dtype=int)
@@ -112,10 +163,20 @@ def test_the_stream_names_runs_as_offline(viterbi):
     classes = np.arange(4)
     rules = {"min_run": 2, "max_gap": 1, "viterbi": viterbi, "namer_weight": 0.6}
     offline = decode(
-        proba, classes, smoothing="none", namer=namer_of(rows, _scores), **rules
+        proba,
+        classes,
+        smoothing="none",
+        namer=namer_of(rows, _scores),
+        max_namer_rest=max_rest,
+        **rules,
     )
     plain = decode(proba, classes, smoothing="none", **rules)
     assert (offline != plain).any()  # the namer renames some runs
+    if max_rest is not None:  # and its rest rule removes some
+        named = decode(
+            proba, classes, smoothing="none", namer=namer_of(rows, _scores), **rules
+        )
+        assert ((offline == 0) & (named != 0)).any()
     stream = LabelRuns(
         classes,
         2,
@@ -123,6 +184,7 @@ def test_the_stream_names_runs_as_offline(viterbi):
         viterbi=viterbi,
         namer=_scores,
         namer_weight=0.6,
+        max_namer_rest=max_rest,
     )
     got = []
     for u in range(T):
@@ -202,6 +264,24 @@ def test_the_namer_names_gestures_that_differ_at_their_end(late_pair):
     assert named > causal + 0.1  # a causal tagger names the start of a run
 
 
+def test_the_namer_learns_rest_and_its_rule_keeps_the_gestures(late_pair):
+    tagger, X, y = late_pair
+    assert tagger.namer_rest_ > 0  # trained on windows of the rest too
+    args = (tagger.namer_.module_, tagger.namer_mean_, tagger.namer_scale_)
+    rest, gesture = [], []
+    for x, labels in zip(X, y):
+        for s, e, v in zip(*runs(labels)):
+            p = np.exp(namer_scores(*args, x[s:e], len(tagger.classes_))[0])
+            (gesture if v else rest).append(p)
+    # held-out runs: the namer tells rest from gestures by their frames
+    assert max(gesture) < 0.2 < 0.8 < min(rest)
+    want = jaccard_index(y, tagger.predict(X))
+    kept = clone_with(tagger, max_namer_rest=0.5).predict(X)
+    assert jaccard_index(y, kept) == pytest.approx(want)  # no gesture lost
+    none = clone_with(tagger, max_namer_rest=1e-6).predict(X)
+    assert all((labels == 0).all() for labels in none)  # every run is rest
+
+
 def test_without_a_namer_the_tagger_is_the_same_network(late_pair):
     tagger, X, _ = late_pair
     X_tr, y_tr = (part[:10] for part in _late_pair(14, 0))
@@ -241,6 +321,20 @@ def test_namer_weight_is_validated():
         SequenceTagger(namer="gru", namer_weight=1.5).fit(X, y)
     with pytest.raises(ValueError, match="namer"):
         SequenceTagger(namer="tcn").fit(X, y)
+    with pytest.raises(ValueError, match="max_namer_rest"):
+        SequenceTagger(max_namer_rest=1.5, namer="gru").fit(X, y)
+    with pytest.raises(ValueError, match="max_namer_rest=0.5 reads the run namer"):
+        SequenceTagger(max_namer_rest=0.5).fit(X, y)
+
+
+def test_the_rest_rule_needs_a_namer_trained_on_rest(late_pair):
+    # a model fitted before the namer learnt rest says so, and how to go on
+    tagger, X, _ = late_pair
+    old = clone_with(tagger, max_namer_rest=0.5)
+    del old.namer_rest_
+    with pytest.raises(ValueError, match="namer_rest_.*max_namer_rest=None"):
+        old.predict(X)
+    old.set_params(max_namer_rest=None).predict(X)  # as before
 
 
 def test_the_decoding_imports_no_torch():
@@ -253,3 +347,26 @@ def test_the_decoding_imports_no_torch():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
     assert out.stdout.strip() == "False"
+
+
+def test_the_namer_trains_on_each_window_as_it_reads_a_run():
+    # packed crops: the backward direction starts at each window's last frame,
+    # as when the namer reads a run alone; padded, it would start in the zeros
+    from skgesture._nn._modules import RecurrentTaggerModule
+    from skgesture._nn._sequence_net import _CropNet
+
+    torch.manual_seed(0)
+    module = RecurrentTaggerModule(3, 4, hidden_sizes=(5,)).eval()
+    X = torch.randn(2, 7, 3)
+    X[1, 4:] = 0.0  # the second window has 4 frames
+    with torch.no_grad():
+        packed = module(X, lengths=torch.tensor([7, 4]))
+        alone = module(X[1:, :4])
+        padded = module(X)
+    torch.testing.assert_close(packed[1, :4], alone[0])
+    torch.testing.assert_close(packed[0], padded[0])
+    assert not torch.allclose(padded[1, :4], alone[0], atol=1e-4)
+    windows = [np.zeros((5, 3), np.float32)] * 2
+    labels = [np.ones(5, dtype=np.int64)] * 2
+    with pytest.raises(ValueError, match="recurrent architecture"):
+        _CropNet(architecture="tcn", packed=True).fit(windows, labels)

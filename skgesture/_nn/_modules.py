@@ -124,7 +124,24 @@ class RecurrentTaggerModule(nn.Module):
         nn.init.xavier_uniform_(self.head.weight)
         nn.init.zeros_(self.head.bias)
 
-    def forward(self, X):
+    def forward(self, X, lengths=None):
+        """Logits of every frame of ``X`` (batch, time, features); with
+        ``lengths`` (frames of each sequence), the padding after them is
+        packed away, so that the backward direction starts at each
+        sequence's last frame (as it does on a sequence alone), and its
+        logits are the read-out of zeros."""
+        if lengths is not None:
+            from torch.nn.utils.rnn import pack_padded_sequence, pad_packed_sequence
+
+            out = pack_padded_sequence(
+                X, lengths.cpu(), batch_first=True, enforce_sorted=False
+            )
+            for k, rnn in enumerate(self.layers):
+                out, _ = rnn(out)
+                if k < len(self.layers) - 1:
+                    out = out._replace(data=self.dropout(self.activation(out.data)))
+            out, _ = pad_packed_sequence(out, batch_first=True, total_length=X.shape[1])
+            return self.head(out)
         out = X
         for k, rnn in enumerate(self.layers):
             out, _ = rnn(out)

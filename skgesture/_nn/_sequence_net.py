@@ -32,15 +32,20 @@ class _CropData(torch.utils.data.Dataset):
     Each crop is a random ``crop_length``-frame slice of a random sequence,
     perturbed by ``augmenter`` (before standardisation, so rotations act on
     raw xyz triples) and standardised; a shorter sequence is padded, its
-    padding left out of the loss. The augmenter's Gaussian noise is drawn
+    padding left out of the loss (with ``packed``, a batch is ``({"X": x,
+    "lengths": frames of each crop}, y)``, for a recurrent module that packs
+    the padding away). The augmenter's Gaussian noise is drawn
     for the whole batch at once, in torch, on the kept frames only: ``noise``
     in the raw features' units is ``noise / scale`` once standardised, so the
     crops are distributed as if each had been noised before its
     standardisation, at a third of the cost.
     """
 
-    def __init__(self, X, y, *, crop_length, augmenter, mean, scale, seed):
+    def __init__(
+        self, X, y, *, crop_length, augmenter, mean, scale, seed, packed=False
+    ):
         self.X, self.y = X, y
+        self.packed = packed
         self.crop_length = crop_length
         self.augmenter = augmenter
         if augmenter is not None:
@@ -66,6 +71,7 @@ class _CropData(torch.utils.data.Dataset):
             mean=self.mean,
             scale=self.scale,
             seed=self.seed,
+            packed=self.packed,
         )
         valid = _WholeSequences(
             [self.X[i] for i in held], [self.y[i] for i in held], self.mean, self.scale
@@ -104,6 +110,8 @@ class _CropData(torch.utils.data.Dataset):
             noise = torch.randn(xb.shape, generator=self.noise_generator)
             xb += noise.mul_(std)
             xb[torch.from_numpy(~kept)] = 0.0  # the padding stays zero
+        if self.packed:  # the module packs the padding away
+            return {"X": xb, "lengths": torch.from_numpy(kept.sum(axis=1))}, yb
         return xb, yb
 
 
@@ -212,7 +220,10 @@ class _CropNet(FramewiseNetwork):
     for frames left out of the loss) and sets ``net_``, ``mean_`` and
     ``scale_``. The training loop is :class:`FramewiseNetwork`'s; the sampler
     draws random crops of whole sequences, the optimiser is AdamW with a
-    one-cycle schedule and gradient clipping.
+    one-cycle schedule and gradient clipping. With ``packed`` (a recurrent
+    architecture only), the padding of a crop shorter than ``crop_length``
+    is packed away, so the network trains on each crop as it reads a
+    sequence alone (the run namer's windows).
     """
 
     def __init__(
@@ -236,6 +247,7 @@ class _CropNet(FramewiseNetwork):
         class_weight=None,
         augmenter=None,
         standardize=True,
+        packed=False,
         early_stopping=False,
         validation_fraction=0.15,
         n_iter_no_change=5,
@@ -261,6 +273,7 @@ class _CropNet(FramewiseNetwork):
         self.class_weight = class_weight
         self.augmenter = augmenter
         self.standardize = standardize
+        self.packed = packed
         self.early_stopping = early_stopping
         self.validation_fraction = validation_fraction
         self.n_iter_no_change = n_iter_no_change
@@ -269,6 +282,8 @@ class _CropNet(FramewiseNetwork):
         self.verbose = verbose
 
     def fit(self, X, y):
+        if self.packed and self.architecture == "tcn":
+            raise ValueError("packed crops need a recurrent architecture, not 'tcn'")
         seed = seed_from(self.random_state)
         frames = np.concatenate(X)
         if self.standardize:
@@ -286,6 +301,7 @@ class _CropNet(FramewiseNetwork):
             mean=self.mean_,
             scale=self.scale_,
             seed=seed,
+            packed=self.packed,
         )
         module, module_kwargs = _module_spec(
             self.architecture,

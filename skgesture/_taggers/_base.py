@@ -150,10 +150,13 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         """``score(rows)``, the run namer's scores of a run's feature rows
         (:func:`~skgesture._taggers._namer.namer_scores`; with ``batch``,
         ``score(list of rows)``, :func:`~skgesture._taggers._namer.namer_batch`),
-        or None: no namer fitted, or ``namer_weight`` 0 (the runs keep the
-        path's labels)."""
+        or None: no namer fitted, or ``namer_weight`` 0 and no
+        ``max_namer_rest`` (the runs keep the path's labels)."""
         fitted = getattr(self, "namer_", None)
-        if fitted is None or float(getattr(self, "namer_weight", 0.0)) <= 0:
+        if fitted is None or (
+            float(getattr(self, "namer_weight", 0.0)) <= 0
+            and getattr(self, "max_namer_rest", None) is None
+        ):
             return None
         module, n_classes = fitted.module_, len(self.classes_)
         mean, scale = self.namer_mean_, self.namer_scale_
@@ -324,6 +327,14 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         max_novelty = getattr(self, "max_novelty", None)
         if max_novelty is not None:
             self._fitted("novelty_", f"max_novelty={max_novelty}", "max_novelty=None")
+        max_namer_rest = getattr(self, "max_namer_rest", None)
+        if max_namer_rest is not None:
+            self._fitted(
+                "namer_rest_",
+                f"max_namer_rest={max_namer_rest}",
+                "max_namer_rest=None (or refit with namer='gru')",
+            )
+            max_namer_rest = float(max_namer_rest)
         return {
             "min_run": self.min_run,
             "max_gap": self.max_gap,
@@ -333,6 +344,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             "max_novelty": None if max_novelty is None else float(max_novelty),
             "viterbi": viterbi,
             "namer_weight": float(getattr(self, "namer_weight", 0.0)),
+            "max_namer_rest": max_namer_rest,
         }
 
     def _fitted_lengths(self, attribute, rule, off):
@@ -400,6 +412,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
             max_novelty=rules["max_novelty"],
             namer=namer,
             namer_weight=rules["namer_weight"],
+            max_namer_rest=rules["max_namer_rest"],
         )
 
     def __sklearn_tags__(self):

@@ -171,6 +171,7 @@ def reject_runs(
     max_novelty=None,
     namer=None,
     namer_weight=0.0,
+    max_namer_rest=None,
 ):
     """Name every gesture run, then set to rest the runs too short or too long
     for their class, too unsure, or unlike its training poses.
@@ -179,7 +180,9 @@ def reject_runs(
     stream decides a run as soon as it ends). With ``namer``, a run first
     takes the name of :func:`~skgesture._taggers._namer.name_run` (the
     tagger's and the namer's scores of the run's rows; two touching runs that
-    take one name are one gesture). Then a run of class ``c`` shorter
+    take one name are one gesture), and with ``max_namer_rest`` a run
+    to which the namer gives a mean probability of rest above it becomes
+    rest. Then a run of class ``c`` shorter
     than ``min_lengths[c]`` frames, longer than ``max_lengths[c]`` frames,
     whose mean raw probability of ``c`` is below ``min_confidence``, or whose
     median novelty for ``c`` is above ``max_novelty``, becomes rest.
@@ -212,7 +215,11 @@ def reject_runs(
         ``start .. end - 1`` (:func:`~skgesture._taggers._namer.namer_of`);
         None keeps the runs' labels.
     namer_weight : float, default=0.0
-        Weight of the namer's scores against the tagger's, in [0, 1].
+        Weight of the namer's scores against the tagger's, in [0, 1] (0:
+        the runs keep their labels).
+    max_namer_rest : float or None, default=None
+        Highest mean probability of rest that the namer may give a run kept;
+        None: the namer's rest is not read.
 
     Returns
     -------
@@ -241,6 +248,7 @@ def reject_runs(
         and namer is None
     ):
         return labels
+    rest_floor = None if max_namer_rest is None else np.log(max_namer_rest)
     if max_novelty is not None and novelty is None:
         raise ValueError("max_novelty needs the novelty of the rows (novelty=)")
     classes = np.asarray(classes)
@@ -250,8 +258,13 @@ def reject_runs(
             continue
         k = int(np.searchsorted(classes, v))
         if namer is not None:
-            k = name_run(raw[s:e], namer(s, e), namer_weight)
-            labels[s:e] = classes[k]
+            scores = namer(s, e)
+            if namer_weight > 0:
+                k = name_run(raw[s:e], scores, namer_weight)
+                labels[s:e] = classes[k]
+            if rest_floor is not None and scores[0] > rest_floor:
+                labels[s:e] = 0
+                continue
         too_short = min_lengths is not None and e - s < min_lengths[k]
         too_long = max_lengths is not None and e - s > max_lengths[k]
         if (
@@ -305,6 +318,7 @@ def apply_run_rules(
     max_novelty=None,
     namer=None,
     namer_weight=0.0,
+    max_namer_rest=None,
 ):
     """The rules of :func:`decode` that follow the path, on its labels.
 
@@ -330,6 +344,7 @@ def apply_run_rules(
         max_novelty=max_novelty,
         namer=namer,
         namer_weight=namer_weight,
+        max_namer_rest=max_namer_rest,
     )
 
 
@@ -432,6 +447,7 @@ def decode(
     max_novelty=None,
     namer=None,
     namer_weight=0.0,
+    max_namer_rest=None,
 ):
     """Per-frame labels of one sequence from its class probabilities.
 
@@ -477,6 +493,9 @@ def decode(
         - 1``; every gesture run is named with them first (:func:`reject_runs`).
     namer_weight : float, default=0.0
         Weight of the namer's scores against the tagger's.
+    max_namer_rest : float or None, default=None
+        Gesture runs to which the namer gives a higher mean probability of
+        rest become rest (:func:`reject_runs`).
 
     Returns
     -------
@@ -514,6 +533,7 @@ def decode(
         max_novelty=max_novelty,
         namer=namer,
         namer_weight=namer_weight,
+        max_namer_rest=max_namer_rest,
     )
 
 
@@ -628,6 +648,8 @@ class LabelRuns:
         second ends.
     namer_weight : float, default=0.0
         Weight of the namer (:func:`reject_runs`).
+    max_namer_rest : float or None, default=None
+        The namer's rest rule (:func:`reject_runs`).
 
     Examples
     --------
@@ -660,10 +682,12 @@ class LabelRuns:
         max_novelty=None,
         namer=None,
         namer_weight=0.0,
+        max_namer_rest=None,
     ):
         self.classes = np.asarray(classes)
         self.namer = namer
         self.namer_weight = float(namer_weight)
+        self.max_namer_rest = max_namer_rest
         self.feature_rows = None  # with a namer: the stretch's feature rows
         self.min_run = int(min_run)
         self.max_gap = int(max_gap)
@@ -788,6 +812,7 @@ class LabelRuns:
                 max_novelty=self.max_novelty,
                 namer=namer,
                 namer_weight=self.namer_weight,
+                max_namer_rest=self.max_namer_rest,
             )
             for cls, s, e, conf in segments_with_confidence(
                 labels, raw, self.classes

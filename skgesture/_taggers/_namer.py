@@ -24,6 +24,8 @@ from skgesture.utils._segments import runs
 
 NAMER_COPIES = 4  # training windows per gesture: itself and 3 with jittered ends
 NAMER_JITTER = 0.1  # sd of a jittered end, as a fraction of the gesture's length
+NAMER_REST = 0.25  # rest windows per gesture window (the rest class of the namer)
+MIN_REST = 4  # shortest rest run that rest windows are drawn from, in frames
 NAMER_HIDDEN = (64,)  # units per direction of the namer's one GRU layer
 # The namer's own training: short windows, larger batches, half the tagger's
 # epochs (its steps per epoch; 300 steps for the recommended model's 600).
@@ -32,6 +34,7 @@ NAMER_TRAINING = {
     "batch_size": 32,
     "learning_rate": 3e-3,
     "dropout": 0.2,
+    "packed": True,  # trained on each window as it reads a run: no padding
 }
 TINY = 1e-9  # floor of a mean probability before its log
 
@@ -95,9 +98,70 @@ def gesture_windows(X, y_idx, seed, copies=NAMER_COPIES, jitter=NAMER_JITTER):
     return windows, labels
 
 
+def rest_windows(X, y_idx, lengths, n_windows, seed):
+    """The namer's rest windows: ``n_windows`` windows of rest rows of ``X``.
+
+    The namer that only ever saw gestures names every run as some gesture;
+    trained also on rest (the training sequences' rest, and all of any
+    background recording given to ``fit``), it gives a run of motion that is
+    no gesture a high probability of rest, which ``max_namer_rest`` reads.
+    Each window lies in one run of rest (of at least ``MIN_REST`` rows),
+    drawn with a probability proportional to its length; its length is one
+    of ``lengths`` (the training gestures'), drawn at random, capped at the
+    run's; every row is labelled rest (0).
+
+    Parameters
+    ----------
+    X : list of ndarray of shape (n_frames_i, n_features)
+    y_idx : list of ndarray of shape (n_frames_i,)
+        Class index of every row (0 rest).
+    lengths : array-like of int
+        Lengths to draw from (none: no window).
+    n_windows : int
+    seed : int
+
+    Returns
+    -------
+    windows : list of ndarray
+    labels : list of ndarray of int64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._namer import rest_windows
+    >>> X = [np.arange(12.0)[:, None]]
+    >>> y = [np.array([0] * 8 + [1] * 4)]
+    >>> W, Y = rest_windows(X, y, [3], 2, 0)
+    >>> [len(w) for w in W], int(max(w.max() for w in W)) < 8, Y[0].tolist()
+    ([3, 3], True, [0, 0, 0])
+    """
+    lengths = np.asarray(lengths, dtype=np.int64)
+    spans = [
+        (i, s, e)
+        for i, y in enumerate(y_idx)
+        for s, e, v in zip(*(a.tolist() for a in runs(np.asarray(y))))
+        if v == 0 and e - s >= MIN_REST
+    ]
+    if not spans or not len(lengths) or n_windows <= 0:
+        return [], []
+    rng = np.random.default_rng(seed)
+    sizes = np.array([e - s for _, s, e in spans], dtype=float)
+    picks = rng.choice(len(spans), size=int(n_windows), p=sizes / sizes.sum())
+    windows, labels = [], []
+    for pick in picks.tolist():
+        i, s, e = spans[pick]
+        n = int(min(rng.choice(lengths), e - s))
+        a = s + int(rng.integers(0, e - s - n + 1))
+        windows.append(X[i][a : a + n])
+        labels.append(np.zeros(n, dtype=np.int64))
+    return windows, labels
+
+
 def name_run(raw, namer_scores, weight):
     """Column of the name of one run: the gesture column with the highest
-    ``(1 - weight) * log(mean raw probability) + weight * namer_scores``.
+    ``(1 - weight) * log(mean raw probability) + weight * namer_scores``
+    (rest, column 0, is never a name: the ``max_namer_rest`` rule of
+    :func:`~skgesture._taggers._decoding.reject_runs` reads the namer's rest).
 
     Parameters
     ----------

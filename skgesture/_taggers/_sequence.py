@@ -23,7 +23,13 @@ from skgesture._taggers._base import (
     _STREAM_CONSTRAINTS,
     _BaseTagger,
 )
-from skgesture._taggers._namer import NAMER_HIDDEN, NAMER_TRAINING, gesture_windows
+from skgesture._taggers._namer import (
+    NAMER_HIDDEN,
+    NAMER_REST,
+    NAMER_TRAINING,
+    gesture_windows,
+    rest_windows,
+)
 from skgesture.utils import PoseNovelty
 from skgesture.utils._fitting import fit_cached, seed_from
 
@@ -157,10 +163,13 @@ class SequenceTagger(_BaseTagger):
         stream's delay).
     namer : {"gru"} or None, default=None
         ``"gru"``: also train a run namer, a bidirectional GRU (one layer of
-        64 units a direction) on the training gestures alone (each gesture
-        and copies of it with jittered ends; half the tagger's epochs,
-        batches of 32 windows of at most 64 frames), which names every
-        gesture run once it has ended, from all of its frames (see
+        64 units a direction) on the training gestures (each gesture and
+        copies of it with jittered ends) and on windows of rest (one for
+        every four gesture windows, from the rest of the training sequences
+        and of any background recording; see ``max_namer_rest``), for half
+        the tagger's epochs, in batches of 32 windows of at most 64 frames
+        read as the namer reads a run (the padding packed away). It names
+        every gesture run once it has ended, from all of its frames (see
         ``namer_weight``). A network with a bounded look-ahead names the
         first frames of a gesture before its end is seen; the namer reads the
         end, and the run rules judge a run only once it has ended, so the
@@ -173,6 +182,11 @@ class SequenceTagger(_BaseTagger):
         probability over the run) + namer_weight * log(the namer's)``; two
         touching runs named alike are one gesture. 0: the runs keep the
         path's labels (as without a namer); in [0, 1].
+    max_namer_rest : float or None, default=None
+        Decision parameter of the namer: a gesture run to which the namer
+        gives a mean probability of rest above ``max_namer_rest`` becomes
+        rest (motion unlike every gesture, read from all of its frames); in
+        (0, 1]. None: the namer's rest is not read. Needs ``namer``.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a network reading a window (the TCN, or
@@ -225,7 +239,10 @@ class SequenceTagger(_BaseTagger):
         With ``namer``: the trained run namer.
     namer_mean_, namer_scale_ : ndarray of shape (n_features,)
         With ``namer``: the standardisation of the namer's inputs (the
-        statistics of the training gestures' frames).
+        statistics of the frames of its training windows).
+    namer_rest_ : int
+        With ``namer``: the rest windows the namer was trained on (0 when
+        the training data had no rest).
     mean_ : ndarray of shape (n_features,)
         Training mean of every feature.
     scale_ : ndarray of shape (n_features,)
@@ -304,6 +321,7 @@ class SequenceTagger(_BaseTagger):
         "lookahead": [Interval(Integral, 0, None, closed="left"), None],
         "namer": [StrOptions({"gru"}), None],
         "namer_weight": [Interval(Real, 0, 1, closed="both")],
+        "max_namer_rest": [Interval(Real, 0, 1, closed="right"), None],
         **_DECODING_CONSTRAINTS,
         **_STREAM_CONSTRAINTS,
         "memory": [None, str, HasMethods(["cache"])],
@@ -354,6 +372,7 @@ class SequenceTagger(_BaseTagger):
         viterbi_lag=6,
         namer=None,
         namer_weight=0.75,
+        max_namer_rest=None,
         stream_past=32,
         stream_future=8,
         memory=None,
@@ -396,6 +415,7 @@ class SequenceTagger(_BaseTagger):
         self.viterbi_lag = viterbi_lag
         self.namer = namer
         self.namer_weight = namer_weight
+        self.max_namer_rest = max_namer_rest
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.memory = memory
@@ -439,6 +459,11 @@ class SequenceTagger(_BaseTagger):
                 f"{self.architecture.upper()} reads to the end of the sequence), or "
                 f"lookahead=None"
             )
+        if self.max_namer_rest is not None and self.namer is None:
+            raise ValueError(
+                f"max_namer_rest={self.max_namer_rest} reads the run namer's rest: "
+                f"set namer='gru', or max_namer_rest=None"
+            )
         X, y_idx, classes = self._validate_fit(X, y)
         self.novelty_ = PoseNovelty().fit(
             X,
@@ -449,7 +474,7 @@ class SequenceTagger(_BaseTagger):
         self._class_weight = _class_weights(self.class_weight, y_idx, len(classes))
         X = [x.astype(np.float32) for x in X]
         self._fit_network(X, y_idx, classes)
-        for name in ("namer_", "namer_mean_", "namer_scale_"):
+        for name in ("namer_", "namer_mean_", "namer_scale_", "namer_rest_"):
             self.__dict__.pop(name, None)  # a refit without a namer
         if self.namer is not None:
             self._fit_namer(X, y_idx, classes)
@@ -463,7 +488,15 @@ class SequenceTagger(_BaseTagger):
         params["max_epochs"] = max(1, self.max_epochs // 2)
         params["steps_per_epoch"] = self.steps_per_epoch
         params["early_stopping"] = False  # the namer's schedule is fixed
-        windows, labels = gesture_windows(X, y_idx, seed_from(params["random_state"]))
+        seed = seed_from(params["random_state"])
+        windows, labels = gesture_windows(X, y_idx, seed)
+        rest, rest_labels = rest_windows(
+            X,
+            y_idx,
+            [len(w) for w in windows],
+            int(round(NAMER_REST * len(windows))),
+            seed + 1,
+        )
         network = _CropNet(
             n_classes=len(classes),
             architecture=self.namer,
@@ -473,8 +506,11 @@ class SequenceTagger(_BaseTagger):
             **params,
         )
         with torch_threads(self._fit_threads()):
-            fitted = fit_cached(self.memory, network, windows, labels)
+            fitted = fit_cached(
+                self.memory, network, windows + rest, labels + rest_labels
+            )
         self.namer_ = fitted.net_
+        self.namer_rest_ = len(rest)
         self.namer_mean_ = fitted.mean_
         self.namer_scale_ = fitted.scale_
 
