@@ -594,10 +594,8 @@ def decode_back(tagger, cached, rate, fps, n_frames):
     p = np.asarray(proba, dtype=np.float64)  # as predict decodes them
     rows = np.column_stack([novelty, np.arange(len(p))])  # + each row's index
     namer = CachedNamer(spans, scores)
-    used = float(getattr(tagger, "namer_weight", 0.0)) > 0 or (
-        getattr(tagger, "max_namer_rest", None) is not None
-    )
-    tagger._namer_rule = lambda: namer.score if len(spans) and used else None
+    used = len(spans) and tagger._reads_namer()
+    tagger._namer_rule = lambda: namer.score if used else None
     labels = tagger._decode(p, untracked, rows)
     segs = segments_with_confidence(labels, p, tagger.classes_)
     if rate is None or same_rate(rate, fps):

@@ -16,6 +16,7 @@ import numpy as np
 import torch
 from torch import nn
 from torch.nn import functional as F
+from torch.nn.utils.rnn import PackedSequence, pack_padded_sequence, pad_packed_sequence
 
 __all__ = [
     "RecurrentTaggerModule",
@@ -130,24 +131,28 @@ class RecurrentTaggerModule(nn.Module):
         packed away, so that the backward direction starts at each
         sequence's last frame (as it does on a sequence alone), and its
         logits are the read-out of zeros."""
-        if lengths is not None:
-            from torch.nn.utils.rnn import pack_padded_sequence, pad_packed_sequence
+        if lengths is None:
+            return self.head(self.recurrent(X))
+        packed = pack_padded_sequence(
+            X, lengths.cpu(), batch_first=True, enforce_sorted=False
+        )
+        out, _ = pad_packed_sequence(
+            self.recurrent(packed), batch_first=True, total_length=X.shape[1]
+        )
+        return self.head(out)
 
-            out = pack_padded_sequence(
-                X, lengths.cpu(), batch_first=True, enforce_sorted=False
-            )
-            for k, rnn in enumerate(self.layers):
-                out, _ = rnn(out)
-                if k < len(self.layers) - 1:
-                    out = out._replace(data=self.dropout(self.activation(out.data)))
-            out, _ = pad_packed_sequence(out, batch_first=True, total_length=X.shape[1])
-            return self.head(out)
-        out = X
+    def recurrent(self, out):
+        """The recurrent layers on a batch ``(batch, time, features)`` or a
+        ``PackedSequence`` (of the same type out), with the activation and
+        the dropout between them: the network before its read-out."""
         for k, rnn in enumerate(self.layers):
             out, _ = rnn(out)
             if k < len(self.layers) - 1:
-                out = self.dropout(self.activation(out))
-        return self.head(out)
+                if isinstance(out, PackedSequence):
+                    out = out._replace(data=self.dropout(self.activation(out.data)))
+                else:
+                    out = self.dropout(self.activation(out))
+        return out
 
 
 class MaskDropout(nn.Module):

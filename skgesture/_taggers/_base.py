@@ -153,10 +153,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         or None: no namer fitted, or ``namer_weight`` 0 and no
         ``max_namer_rest`` (the runs keep the path's labels)."""
         fitted = getattr(self, "namer_", None)
-        if fitted is None or (
-            float(getattr(self, "namer_weight", 0.0)) <= 0
-            and getattr(self, "max_namer_rest", None) is None
-        ):
+        if fitted is None or not self._reads_namer():
             return None
         module, n_classes = fitted.module_, len(self.classes_)
         mean, scale = self.namer_mean_, self.namer_scale_
@@ -168,6 +165,14 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                 return scores(module, mean, scale, rows, n_classes)
 
         return score
+
+    def _reads_namer(self):
+        """Whether a decoding rule reads the run namer's scores: a
+        ``namer_weight`` above 0, or a ``max_namer_rest``."""
+        return (
+            float(getattr(self, "namer_weight", 0.0)) > 0
+            or getattr(self, "max_namer_rest", None) is not None
+        )
 
     def _decode_all(self, proba, untracked, features):
         """:meth:`_decode` of every sequence; the run namer names the runs of

@@ -240,6 +240,8 @@ def reject_runs(
     [0, 0, 0, 0, 0, 0, 0, 0]
     """
     labels = np.array(labels, copy=True)
+    if namer_weight <= 0 and max_namer_rest is None:
+        namer = None  # no rule reads its scores
     if (
         min_confidence <= 0
         and min_lengths is None

@@ -244,11 +244,9 @@ def namer_batch(module, mean, scale, windows, n_classes):
     packed /= np.asarray(scale, dtype=np.float32)
     module.eval()
     with torch.inference_mode():
-        out = PackedSequence(torch.from_numpy(packed), torch.from_numpy(batch_sizes))
-        for k, rnn in enumerate(module.layers):
-            out, _ = rnn(out)
-            if k < len(module.layers) - 1:
-                out = out._replace(data=module.activation(out.data))
+        out = module.recurrent(
+            PackedSequence(torch.from_numpy(packed), torch.from_numpy(batch_sizes))
+        )
         proba = torch.softmax(module.head(out.data), dim=-1).numpy()
     sums = np.add.reduceat(
         proba[where].astype(np.float64), np.cumsum(lengths) - lengths
