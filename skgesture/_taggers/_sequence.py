@@ -174,7 +174,7 @@ class SequenceTagger(_BaseTagger):
         first frames of a gesture before its end is seen; the namer reads the
         end, and the run rules judge a run only once it has ended, so the
         stream stays exact (a gesture followed at once by another is emitted
-        when the second ends). About 15 s more per fit of the recommended
+        when the second ends). About 10-12 s more per fit of the recommended
         model on 2 cores (docs/design.md, "The run namer"). None: no namer.
     namer_weight : float, default=0.75
         Decision parameter of the namer: a run is named by the gesture class
