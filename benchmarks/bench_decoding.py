@@ -283,11 +283,13 @@ def true_gestures(segments):
 # The background variants ``--background`` fits instead of the model's own
 # (each a ``make(X, y)`` object seeded by the fit's seed, or "none"):
 # "synthetic" is make_recommended(background="synthetic") itself; the others
-# vary its count (an int, or a share of the training sequences) and its kinds.
+# vary its count (an int, or a share of the training sequences) and its kinds;
+# "for": "namer" gives them to the run namer alone (background_for="namer").
 NO_FRAGMENT = ("motion", "reversed", "concatenation")
 BACKGROUNDS = {
     "none": None,
     "synthetic": {},
+    "namer": {"for": "namer"},
     "nofragment": {"kinds": NO_FRAGMENT},
     "share10": {"n_sequences": 0.1},
     "share10-nofragment": {"n_sequences": 0.1, "kinds": NO_FRAGMENT},
@@ -325,7 +327,8 @@ def background_of(name, seed):
         return None
     made = skgesture.make_recommended(background="synthetic", random_state=seed)
     params = made.background.get_params()
-    return PossibleKinds(**{**params, **BACKGROUNDS[name]})
+    own = {k: v for k, v in BACKGROUNDS[name].items() if k != "for"}
+    return PossibleKinds(**{**params, **own})
 
 
 def build_model(joints, seed, quick, background=None, fit_threads=None):
@@ -338,7 +341,10 @@ def build_model(joints, seed, quick, background=None, fit_threads=None):
     else:
         model = skgesture.make_recommended(joints=joints, random_state=seed)
     if background is not None:
-        model.set_params(background=background_of(background, seed))
+        model.set_params(
+            background=background_of(background, seed),
+            background_for=(BACKGROUNDS[background] or {}).get("for", "model"),
+        )
     if fit_threads is not None:
         model.set_params(tagger__fit_threads=fit_threads)
     return model

@@ -11,7 +11,8 @@ from numbers import Real
 
 import numpy as np
 from sklearn.pipeline import Pipeline
-from sklearn.utils._param_validation import HasMethods
+from sklearn.utils._metadata_requests import _routing_enabled
+from sklearn.utils._param_validation import HasMethods, StrOptions
 from sklearn.utils.metadata_routing import UNUSED
 from sklearn.utils.metaestimators import available_if
 from sklearn.utils.validation import check_is_fitted
@@ -89,6 +90,14 @@ class GesturePipeline(Pipeline):
         data, at the training rate. None adds nothing. Made from the data
         each ``fit`` sees, so a cross-validation fold's negatives come from
         its own training recordings.
+    background_for : {"model", "namer"}, default="model"
+        Who learns the negatives of ``background``: ``"model"``, every step
+        (the tagger's network learns them as rest); ``"namer"``, the run
+        namer of the last step alone (a :class:`~skgesture.SequenceTagger`
+        with ``namer``, fitted with ``namer_only``): its ``max_namer_rest``
+        rule then sets to rest the runs that look like them, and the
+        network is the one fitted without them (docs/safety.md, "Synthetic
+        negatives for the namer").
 
     Attributes
     ----------
@@ -143,6 +152,7 @@ class GesturePipeline(Pipeline):
     _parameter_constraints: dict = {
         **Pipeline._parameter_constraints,
         "background": [HasMethods(["make"]), None],
+        "background_for": [StrOptions({"model", "namer"})],
     }
 
     def __init__(
@@ -153,11 +163,13 @@ class GesturePipeline(Pipeline):
         memory=None,
         verbose=False,
         background=None,
+        background_for="model",
     ):
         super().__init__(
             steps, transform_input=transform_input, memory=memory, verbose=verbose
         )
         self.background = background
+        self.background_for = background_for
 
     def fit(self, X, y=None, fps=None, **params):
         """Fit every step, and record the frame rate of the training data.
@@ -200,7 +212,10 @@ class GesturePipeline(Pipeline):
                 )
         if self.background is not None:
             self._validate_params()  # a clear error before make(X, y) is called
+            n = len(X)
             X, y = self._with_background(X, y)
+            if self.background_for == "namer":
+                params = self._namer_only_params(params, n, len(X))
         super().fit(X, y, **params)
         self.fps_ = float(rate)
         return self
@@ -213,6 +228,21 @@ class GesturePipeline(Pipeline):
             )
         made = self.background.make(X, y)
         return list(X) + list(made.X), list(y) + list(made.y)
+
+    def _namer_only_params(self, params, n_recordings, n_sequences):
+        """``params`` with the last step's ``namer_only`` flags: the
+        sequences after the first ``n_recordings`` are the negatives."""
+        name, last = self.steps[-1]
+        if getattr(last, "namer", None) is None:
+            raise ValueError(
+                f"background_for='namer' gives the negatives to the run namer of "
+                f"the last step, but {name!r} ({type(last).__name__}) has none: "
+                f"use a SequenceTagger with namer='gru', or background_for='model'"
+            )
+        flags = np.arange(n_sequences) >= n_recordings
+        if _routing_enabled():
+            return {**params, "namer_only": flags}
+        return {**params, f"{name}__namer_only": flags}
 
     def get_metadata_routing(self):
         """Get the metadata routing of this object: the steps' and ``fps``.

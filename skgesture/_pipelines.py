@@ -226,6 +226,7 @@ def make_recommended(
     features="descriptor",
     lookahead=LOOKAHEAD,
     background=None,
+    background_for="model",
     memory=None,
     random_state=None,
     verbose=0,
@@ -287,6 +288,11 @@ def make_recommended(
         (docs/safety.md), hence not the default; recordings of your own
         ordinary work, added to ``X`` with all-zero labels, are the
         stronger lever.
+    background_for : {"model", "namer"}, default="model"
+        Who learns ``background`` (the pipeline's ``background_for``):
+        ``"model"`` the network and the run namer; ``"namer"`` the run namer
+        alone, whose ``max_namer_rest`` rule then rejects the runs that look
+        like the negatives, the network being the one fitted without them.
     memory : None, str or joblib.Memory, default=None
         Cache of the trained network, so that the decoding parameters
         (``tagger__smooth_span``, ``tagger__min_run``, ``tagger__max_gap``,
@@ -394,5 +400,7 @@ def make_recommended(
             f"(e.g. skgesture.datasets.SyntheticBackground), got {background!r}"
         )
     return GesturePipeline(
-        [("features", step), ("tagger", tagger)], background=background
+        [("features", step), ("tagger", tagger)],
+        background=background,
+        background_for=background_for,
     )

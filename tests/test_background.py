@@ -284,3 +284,15 @@ def test_a_background_without_make_or_labels_is_refused(data):
         _pipeline("synthetic").fit(data.X, data.y)
     with pytest.raises(ValueError, match="needs the labels y"):
         _pipeline(SyntheticBackground()).fit(data.X)
+
+
+def test_background_for_is_validated(data):
+    from sklearn.utils._param_validation import InvalidParameterError
+
+    from skgesture.datasets import SyntheticBackground
+
+    pipe = _pipeline(SyntheticBackground(n_sequences=2)).set_params(
+        background_for="tagger"
+    )
+    with pytest.raises(InvalidParameterError, match="'background_for' parameter"):
+        pipe.fit(data.X, data.y)

@@ -7,11 +7,13 @@ all of its frames, offline as live.
 
 import copy
 import io
+import warnings
 
 import joblib
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
+from sklearn.base import clone
 
 torch = pytest.importorskip("torch")
 
@@ -335,6 +337,128 @@ def test_the_rest_rule_needs_a_namer_trained_on_rest(late_pair):
     with pytest.raises(ValueError, match="namer_rest_.*max_namer_rest=None"):
         old.predict(X)
     old.set_params(max_namer_rest=None).predict(X)  # as before
+
+
+def test_a_rest_rule_without_rest_to_learn_warns():
+    # gestures separated by rest too brief to draw a rest window from: the
+    # namer learns no rest, so its rule would silently remove nothing
+    X, y = [], []
+    for x, labels in zip(*_late_pair(4, 1)):
+        keep = np.ones(len(labels), bool)
+        for s, e, v in zip(*runs(labels)):
+            if v == 0:
+                keep[s + 2 : e] = False  # rest runs cut to 2 frames
+        X.append(x[keep])
+        y.append(labels[keep])
+    tagger = SequenceTagger(
+        hidden_sizes=(4,),
+        steps_per_epoch=2,
+        max_epochs=2,
+        namer="gru",
+        max_namer_rest=0.5,
+        random_state=0,
+    )
+    with pytest.warns(UserWarning, match="namer learns no rest.*max_namer_rest=None"):
+        tagger.fit(X, y)
+    assert tagger.namer_rest_ == 0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        clone(tagger).fit(*_late_pair(4, 1))  # with rest to learn, no warning
+    assert not [w for w in caught if "learns no rest" in str(w.message)]
+
+
+def _tiny_namer_tagger(**params):
+    return SequenceTagger(
+        **{
+            "hidden_sizes": (4,),
+            "steps_per_epoch": 3,
+            "max_epochs": 4,
+            "namer": "gru",
+            "random_state": 0,
+            **params,
+        }
+    )
+
+
+def _rest_like(X, seed):
+    """All-rest sequences of the frames of ``X``, shuffled in time."""
+    rng = np.random.default_rng(seed)
+    out = [x[rng.permutation(len(x))] for x in X]
+    return out, [np.zeros(len(x), dtype=np.int64) for x in out]
+
+
+def test_namer_only_sequences_train_the_namer_alone():
+    X, y = _late_pair(4, 2)
+    negatives, rest = _rest_like(X[:2], 0)
+    flags = np.array([False] * 4 + [True] * 2)
+    plain = _tiny_namer_tagger().fit(X, y)
+    routed = _tiny_namer_tagger().fit(X + negatives, y + rest, namer_only=flags)
+    # the network, its statistics and the rules' data are those of the fit
+    # without the negatives ...
+    for a, b in zip(plain.predict_proba(X), routed.predict_proba(X)):
+        assert_array_equal(a, b)
+    assert_array_equal(plain.class_lengths_, routed.class_lengths_)
+    assert_array_equal(plain.novelty_.mean_, routed.novelty_.mean_)
+    # ... and the namer learnt rest windows of the negatives too
+    assert routed.namer_rest_ > plain.namer_rest_ > 0
+    assert not np.allclose(plain.namer_mean_, routed.namer_mean_)
+
+
+@pytest.mark.parametrize(
+    "flags, match",
+    [
+        ([True, False], r"boolean array of shape \(3,\)"),
+        ([0, 0, 1], r"boolean array of shape \(3,\)"),
+        ([False, True, False], r"X\[1\] has gesture label \d at frame \d+"),
+    ],
+)
+def test_namer_only_is_checked(flags, match):
+    X, y = _late_pair(3, 3)
+    with pytest.raises(ValueError, match=match):
+        _tiny_namer_tagger().fit(X, y, namer_only=np.array(flags))
+
+
+def test_namer_only_needs_a_namer():
+    X, y = _late_pair(3, 3)
+    with pytest.raises(ValueError, match="namer_only.*set namer='gru'"):
+        _tiny_namer_tagger(namer=None).fit(X, y, namer_only=np.zeros(3, bool))
+
+
+@pytest.mark.parametrize("routing", [False, True])
+def test_a_pipeline_gives_its_background_to_the_namer(routing):
+    import sklearn
+    from sklearn.preprocessing import FunctionTransformer
+
+    from skgesture import GesturePipeline
+    from skgesture.datasets import SyntheticBackground
+
+    X, y = _late_pair(4, 2)
+
+    def pipe(background_for):
+        return GesturePipeline(
+            [("same", FunctionTransformer()), ("tagger", _tiny_namer_tagger())],
+            background=SyntheticBackground(3, kinds=("motion",), random_state=0),
+            background_for=background_for,
+        )
+
+    with sklearn.config_context(enable_metadata_routing=routing):
+        namer = pipe("namer").fit(X, y)
+        model = pipe("model").fit(X, y)
+    plain = _tiny_namer_tagger().fit(X, y)
+    tagger = namer.named_steps["tagger"]
+    for a, b in zip(plain.predict_proba(X), tagger.predict_proba(X)):
+        assert_array_equal(a, b)  # the network never saw the negatives
+    assert tagger.namer_rest_ > plain.namer_rest_
+    # background_for="model": the network and the rules learn them too
+    assert not np.allclose(
+        model.named_steps["tagger"].novelty_.mean_, plain.novelty_.mean_
+    )
+    with pytest.raises(ValueError, match="background_for='namer'.*has none"):
+        GesturePipeline(
+            [("same", FunctionTransformer()), ("tagger", SequenceTagger())],
+            background=SyntheticBackground(3, random_state=0),
+            background_for="namer",
+        ).fit(X, y)
 
 
 def test_the_decoding_imports_no_torch():

@@ -25,6 +25,7 @@ from skgesture.utils._segments import runs
 NAMER_COPIES = 4  # training windows per gesture: itself and 3 with jittered ends
 NAMER_JITTER = 0.1  # sd of a jittered end, as a fraction of the gesture's length
 NAMER_REST = 0.25  # rest windows per gesture window (the rest class of the namer)
+NAMER_NEGATIVES = 0.25  # more rest windows per gesture window, from namer_only data
 MIN_REST = 4  # shortest rest run that rest windows are drawn from, in frames
 NAMER_HIDDEN = (64,)  # units per direction of the namer's one GRU layer
 # The namer's own training: short windows, larger batches, half the tagger's

@@ -5,6 +5,7 @@ The tagger of the recommended model (:func:`~skgesture.make_recommended`).
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import warnings
 from numbers import Integral, Real
 
 import numpy as np
@@ -22,15 +23,18 @@ from skgesture._taggers._base import (
     _DECODING_CONSTRAINTS,
     _STREAM_CONSTRAINTS,
     _BaseTagger,
+    _untracked,
 )
 from skgesture._taggers._namer import (
+    MIN_REST,
     NAMER_HIDDEN,
+    NAMER_NEGATIVES,
     NAMER_REST,
     NAMER_TRAINING,
     gesture_windows,
     rest_windows,
 )
-from skgesture.utils import PoseNovelty
+from skgesture.utils import PoseNovelty, check_sequence_labels, check_sequences
 from skgesture.utils._fitting import fit_cached, seed_from
 
 __all__ = ["SequenceTagger"]
@@ -293,6 +297,10 @@ class SequenceTagger(_BaseTagger):
     True
     """
 
+    # namer_only is requested by default, so a router hands it on
+    # (GesturePipeline(background_for="namer") with metadata routing on)
+    __metadata_request__fit = {"namer_only": True}
+
     _parameter_constraints: dict = {
         "architecture": [StrOptions({"gru", "lstm", "tcn"})],
         "hidden_sizes": [tuple, list],
@@ -426,7 +434,7 @@ class SequenceTagger(_BaseTagger):
         self.verbose = verbose
 
     @_fit_context(prefer_skip_nested_validation=False)
-    def fit(self, X, y):
+    def fit(self, X, y, namer_only=None):
         """Train the network on random crops of the sequences.
 
         Parameters
@@ -437,6 +445,13 @@ class SequenceTagger(_BaseTagger):
             Per-frame labels, 0 = rest, 1..K gesture classes; both rest and
             gesture frames must occur. A sequence whose labels are all 0 is a
             background recording (see Notes).
+        namer_only : array-like of bool of shape (n_sequences,) or None, \
+default=None
+            Background sequences (all labels 0) that the run namer alone
+            learns, as rest, and the network does not: the
+            ``GesturePipeline(background_for="namer")`` route of synthetic
+            negatives (see Notes). Needs ``namer``. None: every sequence
+            trains both.
 
         Returns
         -------
@@ -464,6 +479,7 @@ class SequenceTagger(_BaseTagger):
                 f"max_namer_rest={self.max_namer_rest} reads the run namer's rest: "
                 f"set namer='gru', or max_namer_rest=None"
             )
+        X, y, negatives = self._split_namer_only(X, y, namer_only)
         X, y_idx, classes = self._validate_fit(X, y)
         self.novelty_ = PoseNovelty().fit(
             X,
@@ -477,13 +493,52 @@ class SequenceTagger(_BaseTagger):
         for name in ("namer_", "namer_mean_", "namer_scale_", "namer_rest_"):
             self.__dict__.pop(name, None)  # a refit without a namer
         if self.namer is not None:
-            self._fit_namer(X, y_idx, classes)
+            self._fit_namer(X, y_idx, classes, negatives)
         return self
 
-    def _fit_namer(self, X, y_idx, classes):
+    def _split_namer_only(self, X, y, namer_only):
+        """``(X, y, negatives)``: the sequences that train the network, and
+        ``(rows, labels)`` of the ``namer_only`` ones (float32 rows; labels 0,
+        ``IGNORE_INDEX`` on untracked rows; an empty list without them),
+        after checking every sequence as ``fit`` checks them."""
+        if namer_only is None:
+            return X, y, []
+        if self.namer is None:
+            raise ValueError(
+                "namer_only sequences are learnt by the run namer alone: set "
+                "namer='gru', or give them to fit as background (all-rest "
+                "sequences without namer_only)"
+            )
+        data = check_sequences(X, ndim=2, estimator=self, reset=True)
+        labels = check_sequence_labels(y, data)
+        flags = np.asarray(namer_only)
+        if flags.shape != (len(data),) or flags.dtype != bool:
+            raise ValueError(
+                f"namer_only must be a boolean array of shape ({len(data)},), "
+                f"one flag per sequence, got {flags.dtype} of shape {flags.shape}"
+            )
+        for i in np.flatnonzero(flags).tolist():
+            if labels[i].any():
+                frame = int(np.flatnonzero(labels[i])[0])
+                raise ValueError(
+                    f"namer_only sequence X[{i}] has gesture label "
+                    f"{labels[i][frame]} at frame {frame}: the namer learns these "
+                    f"sequences as rest, so their labels must all be 0"
+                )
+        negatives = [  # (rows, labels): untracked rows IGNORE_INDEX, others rest
+            (x.astype(np.float32), np.where(u, IGNORE_INDEX, 0))
+            for x, u, flag in zip(data, _untracked(X, data), flags)
+            if flag
+        ]
+        keep = np.flatnonzero(~flags).tolist()
+        return [X[i] for i in keep], [y[i] for i in keep], negatives
+
+    def _fit_namer(self, X, y_idx, classes, negatives=()):
         """Train the run namer on the training gestures (``namer_``,
         ``namer_mean_``, ``namer_scale_``), cached by ``memory`` as the
-        tagger's network is."""
+        tagger's network is; ``negatives`` (``(rows, labels)`` pairs of
+        :meth:`_split_namer_only`) give it rest windows of their own
+        (``NAMER_NEGATIVES`` per gesture window)."""
         params = {**self._training_params(), **NAMER_TRAINING}
         params["max_epochs"] = max(1, self.max_epochs // 2)
         params["steps_per_epoch"] = self.steps_per_epoch
@@ -497,6 +552,24 @@ class SequenceTagger(_BaseTagger):
             int(round(NAMER_REST * len(windows))),
             seed + 1,
         )
+        if negatives:
+            more, more_labels = rest_windows(
+                *zip(*negatives),
+                [len(w) for w in windows],
+                int(round(NAMER_NEGATIVES * len(windows))),
+                seed + 2,
+            )
+            rest, rest_labels = rest + more, rest_labels + more_labels
+        if not rest and self.max_namer_rest is not None:
+            warnings.warn(
+                f"max_namer_rest={self.max_namer_rest} reads the run namer's rest, "
+                f"but the training sequences have no run of rest of at least "
+                f"{MIN_REST} frames: the namer learns no rest and the rule will "
+                f"remove no run. Add recordings of rest or background to fit, or "
+                f"set max_namer_rest=None",
+                UserWarning,
+                stacklevel=3,
+            )
         network = _CropNet(
             n_classes=len(classes),
             architecture=self.namer,
