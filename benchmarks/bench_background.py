@@ -1,11 +1,13 @@
 """Synthetic negatives by their cost: Jaccard change and false events per minute.
 
-Section ``background`` of ``make bench``. ``make_recommended()`` trains on
-gesture recordings alone; ``background="synthetic"`` adds negatives made from
-them at every fit (``SyntheticBackground``: random joint motion, reversed
-gestures, fragments, concatenations). This section fits the recommended model
-with each variant of ``bench_decoding.BACKGROUNDS`` (none, the synthetic
-negatives as shipped, and variants of their count and kinds) on the datasets
+Section ``background`` of ``make bench``. ``make_recommended()`` makes
+negatives from its training recordings at every fit (``background="synthetic"``,
+``SyntheticBackground``: random joint motion, reversed gestures, fragments,
+concatenations) and gives them to its run namer alone
+(``background_for="namer"``). This section fits the recommended model with
+each variant of ``bench_decoding.BACKGROUNDS`` (none, the negatives for the
+namer as shipped, the same given to the whole model, and variants of their
+count and kinds, given to the whole model) on the datasets
 of ``bench_decoding`` and sets them side by side: the Jaccard on every dataset,
 its change from no background (paired by seed), the worst change over the
 datasets, the recall of true PRECOG gestures and the false gesture events per
@@ -55,7 +57,7 @@ from _common import (  # noqa: E402
     save_figure,
 )
 
-VARIANTS = ("none", "synthetic", "nofragment", "share10", "share10-nofragment")
+VARIANTS = ("none", "namer", "synthetic", "nofragment", "share10", "share10-nofragment")
 QUICK_VARIANTS = ("none", "synthetic", "share10-nofragment")
 SEEDS = (0, 1, 2)
 BASE = "none"  # the changes are paired differences from this variant

@@ -342,9 +342,10 @@ def build_parser():
         help="recordings of ordinary work with no command in them (a folder of "
         "your own recordings, read like DATA; labels are not needed), learnt "
         "as rest so that everyday motion fires no gesture; 'synthetic' makes 12 "
-        "background sequences from the training recordings, as "
-        "make_recommended(background='synthetic') does "
-        "(skgesture.datasets.make_background). May be given more than once",
+        "background sequences from the training recordings that the whole model "
+        "learns, as make_recommended(background_for='model') does "
+        "(skgesture.datasets.make_background; the recommended model's run namer "
+        "learns such sequences by default). May be given more than once",
     )
     p.add_argument(
         "-o", "--output", default="model.skg", help="model file (default model.skg)"

@@ -7,6 +7,7 @@ torch.
 
 # SPDX-License-Identifier: BSD-3-Clause
 
+import warnings
 from numbers import Real
 
 import numpy as np
@@ -97,7 +98,8 @@ class GesturePipeline(Pipeline):
         with ``namer``, fitted with ``namer_only``): its ``max_namer_rest``
         rule then sets to rest the runs that look like them, and the
         network is the one fitted without them (docs/safety.md, "Synthetic
-        negatives for the namer").
+        negatives for the namer"). A last step without a run namer gets no
+        negatives, with a warning.
 
     Attributes
     ----------
@@ -212,9 +214,11 @@ class GesturePipeline(Pipeline):
                 )
         if self.background is not None:
             self._validate_params()  # a clear error before make(X, y) is called
-            n = len(X)
-            X, y = self._with_background(X, y)
-            if self.background_for == "namer":
+            if self.background_for == "model":
+                X, y = self._with_background(X, y)
+            elif self._namer_step() is not None:
+                n = len(X)
+                X, y = self._with_background(X, y)
                 params = self._namer_only_params(params, n, len(X))
         super().fit(X, y, **params)
         self.fps_ = float(rate)
@@ -229,16 +233,29 @@ class GesturePipeline(Pipeline):
         made = self.background.make(X, y)
         return list(X) + list(made.X), list(y) + list(made.y)
 
+    def _namer_step(self):
+        """The name of the last step when it has a run namer to learn the
+        negatives (``background_for="namer"``), else None with a warning: the
+        negatives are then not made (``make_recommended().set_params(
+        tagger__namer=None)`` trains as with ``background=None``)."""
+        name, last = self.steps[-1]
+        if getattr(last, "namer", None) is not None:
+            return name
+        warnings.warn(
+            f"background_for='namer' gives the negatives of background to the run "
+            f"namer of the last step, but {name!r} ({type(last).__name__}) has "
+            f"none: no negatives are made. Set background=None to train without "
+            f"them (and silence this), or background_for='model' to give them to "
+            f"the whole model",
+            UserWarning,
+            stacklevel=3,
+        )
+        return None
+
     def _namer_only_params(self, params, n_recordings, n_sequences):
         """``params`` with the last step's ``namer_only`` flags: the
         sequences after the first ``n_recordings`` are the negatives."""
-        name, last = self.steps[-1]
-        if getattr(last, "namer", None) is None:
-            raise ValueError(
-                f"background_for='namer' gives the negatives to the run namer of "
-                f"the last step, but {name!r} ({type(last).__name__}) has none: "
-                f"use a SequenceTagger with namer='gru', or background_for='model'"
-            )
+        name = self.steps[-1][0]
         flags = np.arange(n_sequences) >= n_recordings
         if _routing_enabled():
             return {**params, "namer_only": flags}

@@ -453,12 +453,24 @@ def test_a_pipeline_gives_its_background_to_the_namer(routing):
     assert not np.allclose(
         model.named_steps["tagger"].novelty_.mean_, plain.novelty_.mean_
     )
-    with pytest.raises(ValueError, match="background_for='namer'.*has none"):
-        GesturePipeline(
-            [("same", FunctionTransformer()), ("tagger", SequenceTagger())],
-            background=SyntheticBackground(3, random_state=0),
-            background_for="namer",
-        ).fit(X, y)
+    # a last step without a namer: no negatives are made, and a warning says so
+    seen = {}
+    fit = SequenceTagger.fit
+
+    def spy(self, X, y, **params):
+        seen["n"], seen["params"] = len(X), params
+        return fit(self, X, y, **params)
+
+    bare = GesturePipeline(
+        [("same", FunctionTransformer()), ("tagger", _tiny_namer_tagger(namer=None))],
+        background=SyntheticBackground(3, random_state=0),
+        background_for="namer",
+    )
+    with pytest.warns(UserWarning, match="background_for='namer'.*has none.*"):
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(SequenceTagger, "fit", spy)
+            bare.fit(X, y)
+    assert seen == {"n": len(X), "params": {}}
 
 
 def test_the_decoding_imports_no_torch():

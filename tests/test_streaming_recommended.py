@@ -55,7 +55,9 @@ def _tagger(architecture="gru", **params):
 def _fit(tagger, precog):
     X, y = _split(precog, (1,))
     # the whole-sequence model on joint features, streamed over a trailing window
-    model = make_recommended(features="joints", lookahead=None, random_state=0)
+    model = make_recommended(
+        features="joints", lookahead=None, background=None, random_state=0
+    )  # (these taggers have no run namer to give negatives to)
     model.steps[-1] = ("tagger", tagger)
     return model.fit(X[:4], y[:4])
 

@@ -538,6 +538,33 @@ def test_make_recommended_default_streams_exactly_on_the_descriptor():
     assert offline.steps[-1][1].lookahead is None
     assert offline.steps[0][1].statistics == "sequence"
     assert make_recommended(features="joints").steps[0][1].statistics == "running"
+    # synthetic negatives that the run namer alone learns, and its rule on
+    assert model.background.n_sequences == 12 and model.background_for == "namer"
+    assert model.steps[-1][1].max_namer_rest == 0.5
+
+
+def test_make_recommended_gives_its_negatives_to_the_namer_alone():
+    from sklearn.base import clone
+
+    streams = [make_skeleton_stream(random_state=s) for s in range(3)]
+    X, y = [x for x, _ in streams], [v for _, v in streams]
+    default = _tiny_recommended().fit(X, y)
+    plain = _tiny_recommended(background=None).fit(X, y)
+    F = default[:-1].transform(X)  # (the descriptor's statistics saw them)
+    # the tagger's network is the one fitted on the recordings alone ...
+    alone = clone(default[-1]).fit(F, y)
+    for a, b in zip(default[-1].predict_proba(F), alone.predict_proba(F)):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(default[-1].class_lengths_, alone.class_lengths_)
+    # ... and its namer learnt rest from the negatives too
+    assert default[-1].namer_rest_ > alone.namer_rest_ == plain[-1].namer_rest_
+    # given to the model, the network learns them
+    model = _tiny_recommended(background_for="model").fit(X, y)
+    G = model[:-1].transform(X)
+    together = clone(model[-1]).fit(G, y).predict_proba(G)
+    assert not all(
+        np.array_equal(a, b) for a, b in zip(model[-1].predict_proba(G), together)
+    )
 
 
 def test_make_recommended_descriptor_variant_reads_the_paper_descriptor():
