@@ -216,10 +216,10 @@ class GesturePipeline(Pipeline):
             self._validate_params()  # a clear error before make(X, y) is called
             if self.background_for == "model":
                 X, y = self._with_background(X, y)
-            elif self._namer_step() is not None:
+            elif (name := self._namer_step()) is not None:
                 n = len(X)
                 X, y = self._with_background(X, y)
-                params = self._namer_only_params(params, n, len(X))
+                params = self._namer_only_params(params, name, n, len(X))
         super().fit(X, y, **params)
         self.fps_ = float(rate)
         return self
@@ -252,10 +252,9 @@ class GesturePipeline(Pipeline):
         )
         return None
 
-    def _namer_only_params(self, params, n_recordings, n_sequences):
-        """``params`` with the last step's ``namer_only`` flags: the
-        sequences after the first ``n_recordings`` are the negatives."""
-        name = self.steps[-1][0]
+    def _namer_only_params(self, params, name, n_recordings, n_sequences):
+        """``params`` with the ``namer_only`` flags of the last step, ``name``:
+        the sequences after the first ``n_recordings`` are the negatives."""
         flags = np.arange(n_sequences) >= n_recordings
         if _routing_enabled():
             return {**params, "namer_only": flags}

@@ -545,17 +545,14 @@ default=None
         params["early_stopping"] = False  # the namer's schedule is fixed
         seed = seed_from(params["random_state"])
         windows, labels = gesture_windows(X, y_idx, seed)
+        lengths = [len(w) for w in windows]  # the rest windows' lengths
         rest, rest_labels = rest_windows(
-            X,
-            y_idx,
-            [len(w) for w in windows],
-            int(round(NAMER_REST * len(windows))),
-            seed + 1,
+            X, y_idx, lengths, int(round(NAMER_REST * len(windows))), seed + 1
         )
         if negatives:
             more, more_labels = rest_windows(
                 *zip(*negatives),
-                [len(w) for w in windows],
+                lengths,
                 int(round(NAMER_NEGATIVES * len(windows))),
                 seed + 2,
             )
