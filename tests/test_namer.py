@@ -410,10 +410,13 @@ def test_namer_only_sequences_train_the_namer_alone():
         ([True, False], r"boolean array of shape \(3,\)"),
         ([0, 0, 1], r"boolean array of shape \(3,\)"),
         ([False, True, False], r"X\[1\] has gesture label \d at frame \d+"),
+        ([True, True, True], r"flags all 3 sequences.*not namer_only"),
     ],
 )
 def test_namer_only_is_checked(flags, match):
     X, y = _late_pair(3, 3)
+    if all(flags):
+        y = [np.zeros_like(v) for v in y]  # all rest, as flagged sequences are
     with pytest.raises(ValueError, match=match):
         _tiny_namer_tagger().fit(X, y, namer_only=np.array(flags))
 

@@ -517,6 +517,11 @@ default=None
                 f"namer_only must be a boolean array of shape ({len(data)},), "
                 f"one flag per sequence, got {flags.dtype} of shape {flags.shape}"
             )
+        if flags.all():
+            raise ValueError(
+                f"namer_only flags all {len(flags)} sequences: the network needs "
+                f"recordings of the gestures that are not namer_only"
+            )
         for i in np.flatnonzero(flags).tolist():
             if labels[i].any():
                 frame = int(np.flatnonzero(labels[i])[0])
