@@ -321,6 +321,37 @@ def test_training_crops_get_the_noise_of_the_raw_features_on_kept_frames_only():
     assert not np.array_equal(aug.augment(x, y[0][:20], np.random.RandomState(0))[0], x)
 
 
+def test_training_crops_read_independent_noise_from_a_bank_drawn_again(monkeypatch):
+    """The crops' noise is read from a bank of normal values: within a crop
+    no value repeats, the crops of a batch are uncorrelated, and the bank is
+    drawn again once NOISE_REUSE times its size has been read."""
+    from skgesture._nn import _sequence_net
+    from skgesture._nn._sequence_net import _CropData
+
+    monkeypatch.setattr(_sequence_net, "NOISE_BANK", 1)  # the crops' minimum
+    monkeypatch.setattr(_sequence_net, "NOISE_CROPS", 8)
+    monkeypatch.setattr(_sequence_net, "NOISE_REUSE", 4)
+    X = [np.zeros((500, 5), np.float32) for _ in range(3)]
+    y = [np.zeros(500, np.int64) for _ in X]
+    data = _CropData(
+        X, y, crop_length=40, mean=np.zeros(5), scale=np.ones(5), seed=0,
+        augmenter=SkeletonAugmenter(rotation=0, scale=0, time_warp=0, noise=1.0),
+    )  # fmt: skip
+    xb = data.sample(2)[0].numpy()
+    bank = data._bank
+    assert bank.numel() == 8 * 40 * 5  # NOISE_CROPS crops of 40 frames of 5 features
+    for crop in xb:  # every value of a crop is a distinct draw
+        assert len(np.unique(crop)) == crop.size
+    batch = data.sample(64)[0].numpy().reshape(64, -1)
+    corr = np.corrcoef(batch)[np.triu_indices(64, 1)]
+    assert np.abs(corr).mean() < 0.1 and np.abs(corr).max() < 0.5
+    # 66 crops read 66 * 200 values > 4 * 1600: the bank was drawn again
+    assert data._bank is not bank
+    assert not np.isin(data._bank.numpy(), bank.numpy()).any()
+    everything = np.concatenate([data.sample(16)[0].numpy().ravel() for _ in range(40)])
+    assert abs(everything.std() - 1.0) < 0.03 and abs(everything.mean()) < 0.03
+
+
 # -- JointFeatures -----------------------------------------------------------------
 
 

@@ -161,10 +161,11 @@ class MaskDropout(nn.Module):
     Each value is zeroed with probability ``p`` and the others are scaled by
     ``1 / (1 - p)``, as ``nn.Dropout`` does. On the CPU torch's dropout
     draws a Bernoulli value at a time, and ``torch.rand_like`` a float at a
-    time; here one 64-bit draw gives the 32-bit integers of two values,
-    compared with ``p`` scaled to 2**32 (so ``p`` is exact to 2**-32, finer
-    than a float32 uniform's 2**-24): 2.5x cheaper than ``rand_like`` on the
-    recommended model's layers. The identity in eval mode.
+    time; here one 64-bit draw gives the 16-bit integers of four values,
+    compared with ``p`` scaled to 2**16 (so ``p`` is exact to 2**-16: 0.3
+    drops 0.300003 of the values): 2.4x cheaper than ``rand_like`` on the
+    recommended model's layers (0.21 against 0.50 ms a mask, and 0.35 ms
+    with two 32-bit values a draw). The identity in eval mode.
     """
 
     def __init__(self, p=0.5):
@@ -176,16 +177,18 @@ class MaskDropout(nn.Module):
             return x
         if self.p >= 1.0:
             return torch.zeros_like(x)
-        return x * keep_mask(x, self.p) * (1.0 / (1.0 - self.p))
+        # one product in the graph: the kept values times 1 / (1 - p) exactly
+        scaled = keep_mask(x, self.p).to(x.dtype).mul_(1.0 / (1.0 - self.p))
+        return x * scaled
 
 
 def keep_mask(x, p):
     """A boolean tensor shaped as ``x``: each value False with probability
-    ``p`` (to 2**-32), from torch's global generator of ``x``'s device."""
+    ``p`` (to 2**-16), from torch's global generator of ``x``'s device."""
     n = x.numel()
-    draws = torch.empty((n + 1) // 2, dtype=torch.int64, device=x.device)
-    values = draws.random_(-(2**63), None).view(torch.int32)[:n].view(x.shape)
-    return values >= int(round(p * 2**32)) - 2**31
+    draws = torch.empty((n + 3) // 4, dtype=torch.int64, device=x.device)
+    values = draws.random_(-(2**63), None).view(torch.int16)[:n].view(x.shape)
+    return values >= int(round(p * 2**16)) - 2**15
 
 
 class _DilatedResidual(nn.Module):
