@@ -103,6 +103,21 @@ def comma_list(text):
     return [t.strip() for t in text.split(",") if t.strip()] if text else None
 
 
+def parse_params(pairs):
+    """``["a=1", "b=gru"]`` (``--set PARAM=VALUE ...``) as ``{"a": 1, "b":
+    "gru"}``: a value is a Python literal, else a string."""
+    out = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise SystemExit(f"--set takes PARAM=VALUE, got {pair!r}")
+        try:
+            out[key] = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            out[key] = value
+    return out
+
+
 def save_figure(fig, path, dpi=110):
     """Write a benchmark's matplotlib figure to ``path`` (its folder made when
     missing), close it, and return ``path``."""

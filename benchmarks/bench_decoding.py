@@ -97,6 +97,9 @@ each in cache cells and a figure of its own (``bench_background.py`` sets
 them side by side). ``--jobs N`` fits the missing cells in N worker
 processes, each tagger on ``cpu_count // N`` threads, in cells of their own
 (``-t<threads>``). ``--default-only`` decodes the current default alone.
+``--set PARAM=VALUE ...`` sets parameters of every model before its fit
+(``set_params``, e.g. ``tagger__lookahead=4``), in cells and a figure of
+their own (``-set<hash>``), to measure a training parameter on every dataset.
 
 Usage: ``python benchmarks/bench_decoding.py [--quick] [--seeds 0,1,2]
 [--datasets precog,utkinect,synthetic] [--out-dir DIR] [--background NAME]
@@ -128,6 +131,7 @@ from _common import (  # noqa: E402
     comma_list,
     figure_lines,
     format_table,
+    parse_params,
     print_report,
     save_figure,
 )
@@ -331,11 +335,12 @@ def background_of(name, seed):
     return PossibleKinds(**{**params, **own})
 
 
-def build_model(joints, seed, quick, background=None, fit_threads=None):
+def build_model(joints, seed, quick, background=None, fit_threads=None, params=None):
     """``make_recommended(joints=joints, random_state=seed)`` (quick:
     ``bench_oov.make_model``'s tiny tagger, 20 joints) with the background
     variant ``background`` (``background_of``; None: the model's own);
-    ``fit_threads`` (None: the model's) sets the tagger's."""
+    ``fit_threads`` (None: the model's) sets the tagger's; ``params`` (a
+    dict or None) are set last (``set_params``)."""
     if quick:
         model = make_model(seed, quick=True)
     else:
@@ -347,6 +352,8 @@ def build_model(joints, seed, quick, background=None, fit_threads=None):
         )
     if fit_threads is not None:
         model.set_params(tagger__fit_threads=fit_threads)
+    if params:
+        model.set_params(**params)
     return model
 
 
@@ -470,11 +477,28 @@ def cache_key(sizes):
     return h.hexdigest()[:12]
 
 
+def params_key(params):
+    """A short, stable name of the ``--set`` parameters (``""`` without)."""
+    if not params:
+        return ""
+    text = json.dumps(params, sort_keys=True, default=repr)
+    return "-set" + hashlib.sha1(text.encode()).hexdigest()[:8]
+
+
 def _cell_path(
-    cache_dir, folds, joints, seed, fold_id, key, background=None, fit_threads=None
+    cache_dir,
+    folds,
+    joints,
+    seed,
+    fold_id,
+    key,
+    background=None,
+    fit_threads=None,
+    params=None,
 ):
     bg = "" if background is None else f"-bg{background}"
     bg += "" if fit_threads is None else f"-t{fit_threads}"
+    bg += params_key(params)
     return (
         cache_dir
         / f"{folds.name}-{folds.key}"
@@ -785,6 +809,7 @@ def run(
     out_dir=None,
     background=None,
     n_jobs=1,
+    params=None,
 ):
     """Fit what is missing, decode every setting, return the rows (notes in
     ``NOTES``).
@@ -816,6 +841,11 @@ def run(
         (``tagger__fit_threads``; on 2 cores two one-thread fits at once
         finish 1.6 times sooner than one after the other on two threads),
         in cache cells of their own (``-t<threads>``).
+    params : dict or None, default=None
+        ``set_params`` of every model before its fit (``--set``), e.g.
+        ``{"tagger__lookahead": 4}``: cache cells and a figure of their own
+        (``-set<hash>``, ``params_key``); the decoding grid applies as
+        without them.
 
     Returns
     -------
@@ -844,7 +874,7 @@ def run(
     )
     cache_dir = out_dir / "decoding"
     fit_threads = None if n_jobs == 1 else max(1, (os.cpu_count() or 1) // n_jobs)
-    variant = (background, fit_threads)  # what a cell's name adds to its key
+    variant = (background, fit_threads, params)  # what a cell's name adds to its key
     plan, missing = [], []  # every cell, and the ones to fit
     for name, folds in folds_of.items():
         joints = joints_of(name, quick)
@@ -860,7 +890,7 @@ def run(
         key = cache_key(sizes)
         for seed in seeds:
             make = functools.partial(
-                build_model, joints, seed, quick, background, fit_threads
+                build_model, joints, seed, quick, background, fit_threads, params
             )
             info = {"dataset": folds.name, "joints": joints, "seed": seed, "key": key}
             for fold in folds.folds:
@@ -895,7 +925,10 @@ def run(
     _notes(rows, folds_of, negatives, reference, seeds, quick)
     if background is not None:
         NOTES.append(f"every fit: make_recommended(background={background!r})")
+    if params:
+        NOTES.append(f"every fit: set_params({params!r}) ({params_key(params)[1:]})")
     stem = "decoding" + ("" if background is None else f"_bg{background}")
+    stem += params_key(params).replace("-set", "_set")
     stem += "_quick" if quick else ""
     figure = plot_settings(rows, out_dir / f"{stem}.png")
     with open(out_dir / f"{stem}.json", "w") as fh:  # the rows, to re-plot or quote
@@ -1046,6 +1079,13 @@ def main(argv=None):
         "alone varied over VARY (a smaller grid)",
     )
     parser.add_argument(
+        "--set",
+        nargs="+",
+        default=[],
+        metavar="PARAM=VALUE",
+        help="set_params of every model before its fit (cells of their own)",
+    )
+    parser.add_argument(
         "--jobs", type=int, default=1, help="fits at once (worker processes)"
     )
     args = parser.parse_args(argv)
@@ -1066,6 +1106,7 @@ def main(argv=None):
         out_dir=args.out_dir,
         background=args.background,
         n_jobs=args.jobs,
+        params=parse_params(args.set) or None,
     )
     print_report(rows, format_tables, NOTES)
 

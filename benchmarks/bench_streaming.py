@@ -59,7 +59,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import format_table, machine_line, save_figure
+from _common import format_table, machine_line, parse_params, save_figure
 
 from skgesture import (
     TorchMLPClassifier,
@@ -581,22 +581,6 @@ def format_tables(rows, title=None):
     return "\n".join(out)
 
 
-def _parse_params(pairs):
-    """``["a=1", "b=gru"]`` as ``{"a": 1, "b": "gru"}``."""
-    import ast
-
-    out = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep:
-            raise SystemExit(f"--set takes PARAM=VALUE, got {pair!r}")
-        try:
-            out[key] = ast.literal_eval(value)
-        except (ValueError, SyntaxError):
-            out[key] = value
-    return out
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small smoke run")
@@ -616,7 +600,7 @@ def main():
     )  # fmt: skip
     args = parser.parse_args()
     rows = run(quick=args.quick, sections=tuple(args.sections),
-               recommended_params=_parse_params(args.set),
+               recommended_params=parse_params(args.set),
                methods=args.methods)  # fmt: skip
     print(machine_line())
     print()

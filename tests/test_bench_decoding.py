@@ -349,3 +349,39 @@ def test_a_variant_makes_the_kinds_it_asks_for_that_the_data_can_give():
     X, y = _ramps()  # ramps (slow, then fast): reversible
     kinds = {k for p in variant.make(X, y).pieces for k, _, _ in p}
     assert "reversed" in kinds
+
+
+def test_set_fits_every_model_with_its_params_in_cells_of_their_own(tmp_path):
+    """``--set``: every fit gets the parameters, its cells and figure a name of
+    their own (so the default's cells are never read for them), a note says
+    so; ``parse_params`` reads literals and strings and refuses a bare word."""
+    fitted = []
+    fit = GesturePipeline.fit
+
+    def recording_fit(self, *args, **kwargs):
+        fitted.append(self.named_steps["tagger"].dropout)
+        return fit(self, *args, **kwargs)
+
+    params = {"tagger__dropout": 0.05}
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(GesturePipeline, "fit", recording_fit)
+        rows = bench_decoding.run(
+            quick=True, datasets=["quick A"], out_dir=tmp_path, params=params
+        )
+    assert fitted and all(d == 0.05 for d in fitted)
+    key = bench_decoding.params_key(params)
+    assert key.startswith("-set") and key == bench_decoding.params_key(dict(params))
+    assert key != bench_decoding.params_key({"tagger__dropout": 0.1})
+    assert bench_decoding.params_key(None) == ""
+    cells = sorted(tmp_path.rglob("*.npz"))
+    assert cells and all(key + "-" in c.name for c in cells)
+    figure = next(r for r in rows if r["table"] == "figure")["path"]
+    assert Path(figure).name == f"decoding_{key[1:]}_quick.png"
+    assert any("tagger__dropout" in n for n in bench_decoding.NOTES)
+    assert bench_decoding.parse_params(["a=4", "b=gru", "c=(1, 2)"]) == {
+        "a": 4,
+        "b": "gru",
+        "c": (1, 2),
+    }
+    with pytest.raises(SystemExit, match="PARAM=VALUE"):
+        bench_decoding.parse_params(["lookahead"])
