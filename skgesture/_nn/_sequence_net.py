@@ -100,7 +100,7 @@ class _CropData(torch.utils.data.Dataset):
         rng, length = self.rng, self.crop_length
         xb = np.zeros((batch_size, length, self.mean.size), dtype=np.float32)
         yb = np.full((batch_size, length), IGNORE_INDEX, dtype=np.int64)
-        kept = np.zeros((batch_size, length), dtype=bool)
+        lengths = np.zeros(batch_size, dtype=np.int64)  # frames of each crop
         for b in range(batch_size):
             i = rng.randint(len(self.X))
             x, y = self.X[i], self.y[i]
@@ -118,14 +118,15 @@ class _CropData(torch.utils.data.Dataset):
             np.subtract(x, self.mean, out=rows)
             rows /= self.scale
             yb[b, : len(y)] = y
-            kept[b, : len(x)] = True
+            lengths[b] = len(x)
         xb, yb = torch.from_numpy(xb), torch.from_numpy(yb)
         if self.augmenter is not None and self.augmenter.noise:
             std = torch.from_numpy(np.float32(self.augmenter.noise) / self.scale)
-            for b, n in enumerate(kept.sum(axis=1).tolist()):  # the padding stays 0
-                xb[b, :n].addcmul_(self._noise(n * std.numel()).view(n, -1), std)
+            width = std.numel()
+            for b, n in enumerate(lengths.tolist()):  # the padding stays 0
+                xb[b, :n].addcmul_(self._noise(n * width).view(n, width), std)
         if self.packed:  # the module packs the padding away
-            return {"X": xb, "lengths": torch.from_numpy(kept.sum(axis=1))}, yb
+            return {"X": xb, "lengths": torch.from_numpy(lengths)}, yb
         return xb, yb
 
     def _noise(self, n_values):
