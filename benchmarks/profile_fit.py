@@ -10,8 +10,11 @@ update, and the training loop as a whole.
 cProfile slows the Python-heavy parts more than torch's kernels; compare the
 parts, not the total with an unprofiled fit.
 
-Usage: ``python benchmarks/profile_fit.py [--threads N]`` (``tagger__fit_threads``;
-default the model's, every core).
+Usage: ``python benchmarks/profile_fit.py [--threads N] [--no-profile]``
+(``tagger__fit_threads``; default the model's, every core). ``--no-profile``
+fits without cProfile and prints the fit's wall seconds alone: the command to
+time two versions of the code side by side (``farm-bench --vs``, each on its own
+checkout; docs/benchmarks.md).
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
@@ -47,6 +50,9 @@ def cumulative(stats, suffix, name):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--threads", type=int, default=None, help="fit threads")
+    parser.add_argument(
+        "--no-profile", action="store_true", help="time the fit alone, no cProfile"
+    )
     args = parser.parse_args(argv)
     data = load_precog()
     X, y = data.X[:36], data.y[:36]
@@ -54,6 +60,11 @@ def main(argv=None):
     if args.threads:
         model.set_params(tagger__fit_threads=args.threads)
     model[0].fit_transform(X[:2])  # numba compiles (or loads its cache) here
+    if args.no_profile:
+        start = time.perf_counter()
+        model.fit(X, y, fps=data.fps)
+        print(f"fit of {len(X)} sequences: {time.perf_counter() - start:.1f} s")
+        return
     profile = cProfile.Profile()
     start = time.perf_counter()
     profile.enable()

@@ -14,8 +14,10 @@ from sklearn.pipeline import Pipeline
 torch = pytest.importorskip("torch")
 
 from skgesture import JointFeatures, SequenceTagger  # noqa: E402
+from skgesture._nn import _modules  # noqa: E402
 from skgesture._nn._fast import CausalConvScorer  # noqa: E402
 from skgesture._nn._modules import (  # noqa: E402
+    MaskBank,
     MaskDropout,
     TemporalConvModule,
     frame_probabilities,
@@ -206,6 +208,44 @@ def test_mask_dropout_is_dropout():
     assert torch.equal(drop(odd), first)
     assert 0 < int((first == 0).sum()) < odd.numel()
     assert torch.equal(MaskDropout(1.0).train()(odd), torch.zeros_like(odd))
+
+
+def test_tcn_dropout_masks_are_slices_of_one_bank_drawn_again_never_saved(
+    monkeypatch,
+):
+    import pickle
+
+    monkeypatch.setattr(_modules, "MASK_BANK", 4096)
+    monkeypatch.setattr(_modules, "MASK_MASKS", 1)
+    monkeypatch.setattr(_modules, "MASK_REUSE", 3)
+    module = TemporalConvModule(6, 3, channels=8, n_layers=3, n_stages=2, dropout=0.3)
+    drops = [m for m in module.modules() if isinstance(m, MaskDropout)]
+    assert len(drops) == 6 and all(d.bank is drops[0].bank for d in drops)
+    bank, x = drops[0].bank, torch.ones(4, 100, 8)
+    torch.manual_seed(0)
+    masks = [drops[0].train()(x) for _ in range(4)]  # 3.1 times the bank's size
+    old = bank._values
+    assert old.numel() == 4096
+    masks += [drops[0](x) for _ in range(5)]  # from a bank drawn again
+    assert bank._values is not old and not torch.equal(bank._values, old)
+    values = torch.stack(masks)
+    assert_allclose(torch.unique(values).numpy(), [0.0, 1 / 0.7], rtol=1e-6)
+    assert abs(float((values == 0).float().mean()) - 0.3) < 0.02
+    assert not torch.equal(masks[0], masks[1])  # each mask at its own offset
+    # the same seed, a fresh network, the same masks
+    again = TemporalConvModule(6, 3, channels=8, n_layers=3, n_stages=2, dropout=0.3)
+    torch.manual_seed(0)
+    first = next(m for m in again.modules() if isinstance(m, MaskDropout))
+    assert all(torch.equal(first.train()(x), m) for m in masks)
+    # never saved; a loaded network's layers share one bank still
+    loaded = pickle.loads(pickle.dumps(module))
+    fresh = TemporalConvModule(6, 3, channels=8, n_layers=3, n_stages=2, dropout=0.3)
+    assert len(pickle.dumps(module)) == len(pickle.dumps(fresh))  # no values saved
+    banks = {id(m.bank) for m in loaded.modules() if isinstance(m, MaskDropout)}
+    assert len(banks) == 1
+    assert torch.equal(loaded.eval()(x[..., :6])[-1], module.eval()(x[..., :6])[-1])
+    with pytest.raises(ValueError, match="MaskBank of p=0.5 for a dropout of p=0.3"):
+        MaskDropout(0.3, bank=MaskBank(0.5))
 
 
 def _conv_reference(module, X):

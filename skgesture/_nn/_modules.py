@@ -30,6 +30,12 @@ CPU_HIDDEN_SIZES = (64, 64)
 CPU_DROPOUT = 0.3
 LEAKY_SLOPE = 0.01  # docs/method.md §7.2: LeakyReLU between the paper's BiLSTMs
 KERNEL = 3  # MS-TCN's dilated convolution width
+# A TCN's dropout masks are slices of one bank of at least MASK_BANK values
+# (and MASK_MASKS masks' worth), drawn again once MASK_REUSE times its size
+# has been read from it (MaskBank).
+MASK_BANK = 2**22
+MASK_MASKS = 32
+MASK_REUSE = 16
 
 
 def final_logits(output):
@@ -165,21 +171,94 @@ class MaskDropout(nn.Module):
     compared with ``p`` scaled to 2**16 (so ``p`` is exact to 2**-16: 0.3
     drops 0.300003 of the values): 2.4x cheaper than ``rand_like`` on the
     recommended model's layers (0.21 against 0.50 ms a mask, and 0.35 ms
-    with two 32-bit values a draw). The identity in eval mode.
+    with two 32-bit values a draw). With a ``bank`` (a :class:`MaskBank`
+    of the same ``p``, which the layers of one network share) the scaled
+    mask is a slice of the bank instead: one product a layer. The identity
+    in eval mode.
     """
 
-    def __init__(self, p=0.5):
+    bank = None  # (modules pickled before the mask bank existed)
+
+    def __init__(self, p=0.5, bank=None):
         super().__init__()
         self.p = float(p)
+        if bank is not None and bank.p != self.p:
+            raise ValueError(f"a MaskBank of p={bank.p} for a dropout of p={self.p}")
+        self.bank = bank
 
     def forward(self, x):
         if not self.training or self.p == 0.0:
             return x
         if self.p >= 1.0:
             return torch.zeros_like(x)
+        if self.bank is not None:
+            return x * self.bank.take(x)
         # one product in the graph: the kept values times 1 / (1 - p) exactly
         scaled = keep_mask(x, self.p).to(x.dtype).mul_(1.0 / (1.0 - self.p))
         return x * scaled
+
+
+class MaskBank:
+    """Scaled dropout masks read from one bank at random offsets.
+
+    The bank holds at least ``MASK_BANK`` values (and ``MASK_MASKS`` masks'
+    worth), each ``1 / (1 - p)`` or, with probability ``p``, 0 (drawn by
+    :func:`keep_mask` from torch's global generator at the first training
+    step, so the fit's seed gives the same bank); a mask is the slice of
+    the size of its input at an offset drawn from the same generator. The
+    bank is drawn again once ``MASK_REUSE`` times its size has been read from
+    it, and is never saved (a loaded network draws its own when it trains).
+    The layers of the recommended network share one bank: a mask then costs
+    one offset and a product instead of a draw, a comparison, a conversion
+    and a product (docs/benchmarks.md, "Cheaper random numbers"). Within a
+    mask the values are independent draws; two masks share values only where
+    their slices overlap, and then at other positions unless their offsets
+    differ by a multiple of the input's size along its last axes.
+
+    Parameters
+    ----------
+    p : float
+        Drop probability, in [0, 1).
+
+    Examples
+    --------
+    >>> import torch
+    >>> from skgesture._nn._modules import MaskBank, MaskDropout
+    >>> bank = MaskBank(0.3)
+    >>> drop = MaskDropout(0.3, bank=bank).train()
+    >>> _ = torch.manual_seed(0)
+    >>> out = drop(torch.ones(64, 256, 32))
+    >>> round(float((out == 0).float().mean()), 2), round(float(out.max()), 4)
+    (0.3, 1.4286)
+    """
+
+    def __init__(self, p):
+        self.p = float(p)
+        self._values, self._unread = None, 0
+
+    def __getstate__(self):
+        return {"p": self.p}  # the values are drawn again, never saved
+
+    def __setstate__(self, state):
+        self.__init__(state["p"])
+
+    def take(self, x):
+        """The scaled mask of ``x``: a tensor of its shape, dtype and device."""
+        n, values = x.numel(), self._values
+        if (
+            values is None
+            or self._unread <= 0
+            or values.numel() < n
+            or values.dtype != x.dtype
+            or values.device != x.device
+        ):
+            size = max(MASK_BANK, MASK_MASKS * n)
+            values = torch.empty(size, dtype=x.dtype, device=x.device)
+            values = keep_mask(values, self.p).to(x.dtype).mul_(1.0 / (1.0 - self.p))
+            self._values, self._unread = values, MASK_REUSE * size
+        self._unread -= n
+        start = int(torch.randint(values.numel() - n + 1, ()))
+        return values[start : start + n].view(x.shape)
 
 
 def keep_mask(x, p):
@@ -197,7 +276,7 @@ class _DilatedResidual(nn.Module):
 
     causal = False  # (modules pickled before causal layers existed)
 
-    def __init__(self, dilation, channels, dropout, causal=False):
+    def __init__(self, dilation, channels, dropout, causal=False, bank=None):
         super().__init__()
         self.causal = causal
         self.conv = nn.Conv1d(
@@ -208,7 +287,7 @@ class _DilatedResidual(nn.Module):
             dilation=dilation,
         )
         self.mix = nn.Conv1d(channels, channels, 1)
-        self.dropout = MaskDropout(dropout)
+        self.dropout = MaskDropout(dropout, bank=bank)
 
     def forward(self, h):
         """``(batch, time, channels)`` in and out."""
@@ -235,11 +314,14 @@ def pointwise(conv, h):
 
 
 class _Stage(nn.Module):
-    def __init__(self, n_inputs, n_outputs, channels, n_layers, dropout, causal=False):
+    def __init__(
+        self, n_inputs, n_outputs, channels, n_layers, dropout, causal=False, bank=None
+    ):
         super().__init__()
         self.inp = nn.Conv1d(n_inputs, channels, 1)
         self.layers = nn.ModuleList(
-            _DilatedResidual(2**k, channels, dropout, causal) for k in range(n_layers)
+            _DilatedResidual(2**k, channels, dropout, causal, bank)
+            for k in range(n_layers)
         )
         self.out = nn.Conv1d(channels, n_outputs, 1)
 
@@ -268,7 +350,8 @@ class TemporalConvModule(nn.Module):
     n_stages : int, default=2
         The first stage plus refinement stages.
     dropout : float, default=0.3
-        Drop probability inside the residual layers.
+        Drop probability inside the residual layers; their masks are slices
+        of one :class:`MaskBank` of the network.
     lookahead : int or None, default=None
         None: every convolution reads ``t - d, t, t + d`` (the output of a
         frame depends on frames far on both sides: whole sequences). An int
@@ -295,6 +378,7 @@ class TemporalConvModule(nn.Module):
         super().__init__()
         self.lookahead = lookahead
         causal = lookahead is not None
+        bank = MaskBank(dropout) if 0.0 < dropout < 1.0 else None  # all layers'
         self.stages = nn.ModuleList(
             _Stage(
                 n_inputs if k == 0 else n_outputs,
@@ -303,6 +387,7 @@ class TemporalConvModule(nn.Module):
                 n_layers,
                 dropout,
                 causal,
+                bank,
             )
             for k in range(n_stages)
         )
