@@ -55,7 +55,10 @@ Protocol
   the datasets; the **recall** of true PRECOG gestures (those of at least
   ``MIN_TRUE_LENGTH`` = 5 frames found by an event of the same class at IoU >=
   ``MIN_IOU`` = 0.5, ``event_recall``; pooled over the folds of a seed, then
-  mean and sd over seeds); and the **false events per minute** on the pooled
+  mean and sd over seeds), and why the others were missed (``event_misses``:
+  the share of the gestures of every seed found, named wrongly, merged with
+  another, with boundaries too far off, or with no event; the default's shares
+  in the notes); and the **false events per minute** on the pooled
   negatives of the PRECOG models (every event is false; minutes are each
   stream's rows over its rate, as in ``bench_oov``; mean over folds, then over
   seeds).
@@ -164,7 +167,7 @@ from skgesture.datasets import (  # noqa: E402
     make_background,
     make_gesture_streams,
 )
-from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
+from skgesture.metrics import event_misses, event_recall, jaccard_index  # noqa: E402
 from skgesture.utils import runs  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -655,8 +658,11 @@ def score_cell(cell, tagger, settings, y_te, truth, negatives):
         score = {"jaccard": float(jaccard_index(y_te, [d[0] for d in decoded]))}
         if truth is not None:
             n = sum(len(t) for t in truth)
-            recall = event_recall(truth, [d[1] for d in decoded], min_iou=MIN_IOU)
+            events = [d[1] for d in decoded]
+            recall = event_recall(truth, events, min_iou=MIN_IOU)
+            misses = event_misses(truth, events, min_iou=MIN_IOU)
             score.update(found=float(recall * n) if n else 0.0, gestures=n)
+            score["misses"] = misses
         score["events"] = {
             name: sum(
                 len(decode_back(tagger, c, f, fps, len(x))[1])
@@ -730,6 +736,7 @@ def _reference_scores(cells, k, negatives, minutes):
         "events_per_min_by": {},
         "events": nan,
         "minutes": minutes,
+        "misses": {},
     }
     if not cells:
         return out
@@ -745,6 +752,12 @@ def _reference_scores(cells, k, negatives, minutes):
         ]
     )
     out["gestures"] = int(gestures[0])
+    pooled = [c["misses"] for run in runs for c in run]  # every seed's gestures
+    total = sum(sum(m.values()) for m in pooled)
+    out["misses"] = {
+        outcome: sum(m[outcome] for m in pooled) / total if total else nan
+        for outcome in pooled[0]
+    }
     if negatives:
         events = [[sum(c["events"].values()) for c in run] for run in runs]
         out["events"] = float(np.mean([np.mean(e) for e in events]))
@@ -855,6 +868,7 @@ def run(
         ``default`` and ``chosen`` (bool), ``jaccard``, ``jaccard_sd`` and
         ``jaccard_change`` (``{dataset: value}``), ``worst_change``,
         ``worst_dataset``, ``recall`` (``recall_sd``, ``gestures`` per seed),
+        ``misses`` (``{outcome: share}`` of ``event_misses``),
         ``events_per_min`` (``events_per_min_sd``, ``events_per_min_by``
         negative dataset), ``events`` (per run), ``minutes`` and ``runs``
         (``{dataset: "seedsxfolds"}``); then one ``table="figure"`` row
@@ -980,6 +994,15 @@ def _notes(rows, folds_of, negatives, reference, seeds, quick):
     for name, data in negatives.items():
         NOTES.append(f"{name}: {data.how}, {data.minutes:.1f} minutes")
     default = next(r for r in rows if r["default"])
+    if default["misses"]:
+        shares = ", ".join(
+            f"{outcome.replace('_', ' ')} {share:.3f}"
+            for outcome, share in default["misses"].items()
+        )
+        NOTES.append(
+            f"true {reference} gestures under the current default, pooled over "
+            f"seeds (event_misses: why each missed one was missed): {shares}"
+        )
     chosen = next(r for r in rows if r["chosen"])
     NOTES.append(
         f"chosen (worst change >= -{TOLERANCE}, then fewest false events/min): "

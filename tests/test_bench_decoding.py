@@ -29,7 +29,7 @@ import bench_decoding  # noqa: E402
 from test_background import _ramps  # noqa: E402
 
 from skgesture import GesturePipeline  # noqa: E402
-from skgesture.metrics import event_recall, jaccard_index  # noqa: E402
+from skgesture.metrics import event_misses, event_recall, jaccard_index  # noqa: E402
 from skgesture.utils._segments import labels_to_segments  # noqa: E402
 
 KEYS = {
@@ -52,6 +52,7 @@ KEYS = {
     "events",
     "minutes",
     "runs",
+    "misses",
 }
 PARAMS = bench_decoding.PARAMS
 
@@ -71,6 +72,11 @@ def quick_run(tmp_path_factory):
         mp.setattr(GesturePipeline, "fit", recording_fit)
         rows = bench_decoding.run(quick=True, out_dir=out)
     return out, rows, fitted
+
+
+def bench_decoding_misses():
+    """The outcomes of a missed gesture, in ``event_misses``' order."""
+    return ["wrong_class", "merged", "boundaries", "no_event"]
 
 
 def _settings(rows):
@@ -97,6 +103,9 @@ def test_rows_keys_and_ranges(quick_run):
             assert -1.0 <= r["jaccard_change"][d] <= 1.0
             assert np.isnan(r["jaccard_sd"][d])  # one seed: no spread
         assert 0.0 <= r["recall"] <= 1.0 and r["gestures"] > 0
+        assert list(r["misses"]) == ["found", *bench_decoding_misses()]
+        assert sum(r["misses"].values()) == pytest.approx(1.0)
+        assert r["misses"]["found"] == pytest.approx(r["recall"])  # one seed
         assert np.isfinite(r["events_per_min"]) and r["events_per_min"] >= 0.0
         assert set(r["events_per_min_by"]) == negatives
         assert r["minutes"] > 0.0
@@ -224,6 +233,9 @@ def test_default_row_is_what_the_pipeline_predicts(quick_run):
     truth = [bench_decoding.true_gestures(data.segments[i]) for i in te]
     found = event_recall(truth, model.predict_segments(X_te, fps=data.fps))
     assert default["recall"] == pytest.approx(found)
+    misses = event_misses(truth, model.predict_segments(X_te, fps=data.fps))
+    n = sum(misses.values())
+    assert default["misses"] == pytest.approx({k: v / n for k, v in misses.items()})
     assert model.fps_ != negatives["synthetic B"].fps[0]
     for neg_name, neg in negatives.items():
         segments = model.predict_segments(neg.X, fps=neg.fps)
@@ -245,6 +257,8 @@ def test_figure_and_tables(quick_run):
         r["setting"] for r in _settings(rows)
     ]
     assert any(n.startswith("chosen") for n in saved["notes"])
+    (why,) = [n for n in saved["notes"] if "event_misses" in n]
+    assert "wrong class" in why and "no event" in why  # the default's misses
     text = bench_decoding.format_tables(rows, "decoding")
     lines = [line for line in text.splitlines() if line.startswith("| ")]
     assert len(lines) == 1 + len(_settings(rows))  # the header and a row each

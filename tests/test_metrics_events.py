@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from skgesture.metrics import event_recall, rejection_curve
+from skgesture.metrics import event_misses, event_recall, rejection_curve
 
 
 def test_recall_needs_same_class_and_enough_overlap():
@@ -20,6 +20,51 @@ def test_recall_needs_same_class_and_enough_overlap():
     assert event_recall(true, events) == pytest.approx(1 / 3)
     # a looser overlap rule finds the third gesture too
     assert event_recall(true, events, min_iou=0.05) == pytest.approx(2 / 3)
+
+
+def test_event_misses_says_why_each_missed_gesture_was_missed():
+    true = [
+        np.array([[1, 10, 40], [2, 60, 90], [1, 100, 110], [1, 112, 122]]),
+        np.array([[2, 0, 50], [1, 80, 100], [3, 200, 230]]),
+    ]
+    events = [
+        np.array(
+            [
+                [1, 12, 40, 0.9],  # IoU 28/30: found
+                [1, 60, 90, 0.9],  # right place, wrong class
+                [1, 100, 122, 0.9],  # one event over two gestures: both merged
+            ]
+        ),
+        np.array(
+            [
+                [2, 0, 10, 0.9],  # the right class, IoU 0.2, no other gesture
+                [2, 40, 50, 0.9],  # a second piece of it, still too little
+                [1, 80, 100, 0.3],  # would find it, but under min_confidence
+            ]
+        ),
+    ]
+    counts = event_misses(true, events, min_confidence=0.5)
+    assert counts == {
+        "found": 1,
+        "wrong_class": 1,
+        "merged": 2,
+        "boundaries": 1,
+        "no_event": 2,
+    }
+    # the outcomes partition the gestures, and "found" is event_recall's count
+    assert sum(counts.values()) == 7
+    assert counts["found"] / 7 == pytest.approx(
+        event_recall(true, events, min_confidence=0.5)
+    )
+    for min_iou in (0.1, 0.5, 0.9):
+        found = event_misses(true, events, min_iou=min_iou)["found"]
+        assert found / 7 == pytest.approx(event_recall(true, events, min_iou=min_iou))
+    # a looser overlap turns the too-short events into found gestures
+    assert event_misses(true, events, min_iou=0.1)["found"] == 5
+    with pytest.raises(ValueError, match="true_segments has 2 sequences, events 1"):
+        event_misses(true, events[:1])
+    with pytest.raises(ValueError, match=r"events\[0\], row 0: end 5 is not after"):
+        event_misses(true[:1], [np.array([[1, 5, 5, 0.9]])])
 
 
 def test_the_best_matching_confidence_decides_when_a_gesture_is_found():

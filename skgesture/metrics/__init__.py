@@ -5,12 +5,13 @@ The ChaLearn LAP 2014 Jaccard index exactly as the official script computes it
 the frame confusion matrix, the per-class report (frame precision, recall and F1,
 gestures found), the segmental F1@k and edit scores of temporal action
 segmentation, the event-level recall and false events per minute of a command
-interface (``rejection_curve``), and scorers for ``GridSearchCV``.
+interface (``rejection_curve``), why true gestures were missed
+(``event_misses``), and scorers for ``GridSearchCV``.
 """
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-from skgesture.metrics._events import event_recall, rejection_curve
+from skgesture.metrics._events import event_misses, event_recall, rejection_curve
 from skgesture.metrics._jaccard import jaccard_index, jaccard_index_segments
 from skgesture.metrics._scorers import (
     SCORERS,
@@ -37,6 +38,7 @@ __all__ = [
     "segmental_f1",
     "edit_score",
     "event_recall",
+    "event_misses",
     "rejection_curve",
     "jaccard_scorer",
     "make_jaccard_scorer",

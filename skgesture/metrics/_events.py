@@ -19,9 +19,11 @@ import numbers
 import numpy as np
 from sklearn.utils import Bunch
 
-__all__ = ["event_recall", "rejection_curve"]
+__all__ = ["event_misses", "event_recall", "rejection_curve"]
 
 DEFAULT_THRESHOLDS = tuple(np.round(np.arange(0.0, 1.0, 0.05), 2))
+# What became of each true gesture (event_misses), in this order of precedence.
+OUTCOMES = ("found", "wrong_class", "merged", "boundaries", "no_event")
 
 
 def _rows(value, width, what, index):
@@ -128,6 +130,82 @@ def event_recall(true_segments, events, *, min_confidence=0.0, min_iou=0.5):
         true_segments, events, thresholds=[min_confidence], min_iou=min_iou
     )
     return float(curve.recall[0])
+
+
+def event_misses(true_segments, events, *, min_confidence=0.0, min_iou=0.5):
+    """What became of every true gesture: found, or why it was missed.
+
+    :func:`event_recall` counts the gestures found; this says why the others
+    were not, which tells what to improve: the naming (``"wrong_class"``)
+    or the segmentation (``"merged"``, ``"boundaries"``), or the detection
+    (``"no_event"``). Each true gesture gets the first outcome that holds:
+
+    * ``"found"``: an event of its class overlaps it with an intersection
+      over union of at least ``min_iou`` (as :func:`event_recall`);
+    * ``"wrong_class"``: events overlap it, none of its class;
+    * ``"merged"``: an event of its class overlaps it, below ``min_iou``, and
+      that event (the one of highest overlap) overlaps another true gesture
+      too: two gestures read as one;
+    * ``"boundaries"``: an event of its class overlaps it, below ``min_iou``,
+      and overlaps no other true gesture: its ends are too far off, or the
+      gesture is split into pieces;
+    * ``"no_event"``: no event overlaps it.
+
+    Events below ``min_confidence`` do not count.
+
+    Parameters
+    ----------
+    true_segments : list of array-like of shape (n_gestures_i, 3)
+        Rows ``(class, start, end)`` per sequence, ``end`` exclusive.
+    events : list of array-like of shape (n_events_i, 4)
+        Rows ``(class, start, end, confidence)`` per sequence, as
+        ``predict_segments`` returns them.
+    min_confidence : float, default=0.0
+        Events below this confidence do not count.
+    min_iou : float, default=0.5
+        The overlap an event needs to find a gesture.
+
+    Returns
+    -------
+    dict
+        The count of true gestures of every outcome, in the order above.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture.metrics import event_misses
+    >>> true = [np.array([[1, 10, 40], [2, 60, 90], [1, 100, 110],
+    ...                   [1, 112, 122], [2, 150, 200], [1, 300, 330]])]
+    >>> events = [np.array([[1, 12, 42, 0.9], [1, 60, 90, 0.8],
+    ...                     [1, 100, 122, 0.7], [2, 150, 160, 0.6]])]
+    >>> event_misses(true, events)
+    {'found': 1, 'wrong_class': 1, 'merged': 2, 'boundaries': 1, 'no_event': 1}
+    """
+    _check_threshold_like(min_iou, "min_iou")
+    true_segments, events = _check_lists(true_segments, events)
+    counts = dict.fromkeys(OUTCOMES, 0)
+    for i, (t, p) in enumerate(zip(true_segments, events)):
+        true, pred = _rows(t, 3, "true_segments", i), _rows(p, 4, "events", i)
+        pred = pred[pred[:, 3] >= min_confidence]
+        for c, s, e in true:
+            inter = np.minimum(e, pred[:, 2]) - np.maximum(s, pred[:, 1])
+            over = pred[inter > 0]
+            same = over[over[:, 0] == c]
+            if not len(over):
+                counts["no_event"] += 1
+                continue
+            if not len(same):
+                counts["wrong_class"] += 1
+                continue
+            inter = np.minimum(e, same[:, 2]) - np.maximum(s, same[:, 1])
+            iou = inter / ((e - s) + (same[:, 2] - same[:, 1]) - inter)
+            if iou.max() >= min_iou:
+                counts["found"] += 1
+                continue
+            _, bs, be, _ = same[np.argmax(iou)]
+            others = (np.minimum(be, true[:, 2]) > np.maximum(bs, true[:, 1])).sum()
+            counts["merged" if others > 1 else "boundaries"] += 1
+    return counts
 
 
 def rejection_curve(
