@@ -78,14 +78,23 @@ def _best_match(true, pred, min_iou):
     out = np.full(len(true), -np.inf)
     for i, (c, s, e) in enumerate(true):
         same = pred[pred[:, 0] == c]
-        if not len(same):
-            continue
-        inter = np.minimum(e, same[:, 2]) - np.maximum(s, same[:, 1])
-        union = (e - s) + (same[:, 2] - same[:, 1]) - inter
-        ok = (inter > 0) & (inter >= min_iou * union)
+        ok = _finds(s, e, same, min_iou)
         if ok.any():
             out[i] = same[ok, 3].max()
     return out
+
+
+def _overlaps(s, e, rows):
+    """Intersection and union, in frames, of ``[s, e)`` with every row
+    ``(class, start, end, ...)``."""
+    inter = np.minimum(e, rows[:, 2]) - np.maximum(s, rows[:, 1])
+    return inter, (e - s) + (rows[:, 2] - rows[:, 1]) - inter
+
+
+def _finds(s, e, rows, min_iou):
+    """Which rows overlap ``[s, e)`` with an IoU of at least ``min_iou``."""
+    inter, union = _overlaps(s, e, rows)
+    return (inter > 0) & (inter >= min_iou * union)
 
 
 def _check_threshold_like(value, name):
@@ -188,8 +197,7 @@ def event_misses(true_segments, events, *, min_confidence=0.0, min_iou=0.5):
         true, pred = _rows(t, 3, "true_segments", i), _rows(p, 4, "events", i)
         pred = pred[pred[:, 3] >= min_confidence]
         for c, s, e in true:
-            inter = np.minimum(e, pred[:, 2]) - np.maximum(s, pred[:, 1])
-            over = pred[inter > 0]
+            over = pred[_overlaps(s, e, pred)[0] > 0]
             same = over[over[:, 0] == c]
             if not len(over):
                 counts["no_event"] += 1
@@ -197,13 +205,12 @@ def event_misses(true_segments, events, *, min_confidence=0.0, min_iou=0.5):
             if not len(same):
                 counts["wrong_class"] += 1
                 continue
-            inter = np.minimum(e, same[:, 2]) - np.maximum(s, same[:, 1])
-            iou = inter / ((e - s) + (same[:, 2] - same[:, 1]) - inter)
-            if iou.max() >= min_iou:
+            if _finds(s, e, same, min_iou).any():  # event_recall's rule
                 counts["found"] += 1
                 continue
-            _, bs, be, _ = same[np.argmax(iou)]
-            others = (np.minimum(be, true[:, 2]) > np.maximum(bs, true[:, 1])).sum()
+            inter, union = _overlaps(s, e, same)
+            _, bs, be, _ = same[np.argmax(inter / union)]
+            others = (_overlaps(bs, be, true)[0] > 0).sum()
             counts["merged" if others > 1 else "boundaries"] += 1
     return counts
 
