@@ -31,6 +31,8 @@ MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
 VITERBI_PENALTY = 5.0  # the duration-aware path: nats to enter a gesture
 MAX_NOVELTY = 1.75  # runs whose poses are this far from their class's are rest
 NAMER_WEIGHT = 0.75  # the run namer's share of a run's name (docs/design.md)
+NAMER_UNITS = (128,)  # the run namer's GRU: one layer of 128 units a direction
+NAMER_STRIDE = 2  # reading every second frame (docs/design.md, "The run namer")
 MAX_NAMER_REST = 0.5  # a run the namer calls rest at more than this is rest
 BACKGROUND_SEQUENCES = 12  # synthetic negatives made at every fit (background=)
 
@@ -240,8 +242,9 @@ def make_recommended(
     stage, a smoothing loss; Farha & Gall's MS-TCN) whose convolutions are
     causal and whose output for a frame is read 8 frames later, trained with
     AdamW and a warm-up cosine schedule on augmented 256-frame crops (time
-    warp, noise); a small bidirectional GRU trained on the gestures alone
-    names every run once it has ended (the run namer). What it predicts
+    warp, noise); a small bidirectional GRU (128 units a direction, reading
+    every second frame) trained on the gestures alone names every run once it
+    has ended (the run namer). What it predicts
     offline is what :class:`~skgesture.streaming.StreamingRecognizer` gives
     live, to the frame, so an offline benchmark of it is the live robot's.
 
@@ -388,6 +391,8 @@ default="synthetic"
         namer="gru",
         namer_weight=NAMER_WEIGHT,
         max_namer_rest=MAX_NAMER_REST,
+        namer_hidden_sizes=NAMER_UNITS,
+        namer_stride=NAMER_STRIDE,
         fit_threads="all",
         memory=memory,
         device=device,

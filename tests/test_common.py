@@ -128,7 +128,7 @@ BAD_PARAMS = {
         "min_duration": -0.5, "max_duration": 0.0, "viterbi_penalty": -1.0,
         "viterbi_duration": "long", "max_novelty": 0.0, "namer": "tcn",
         "namer_weight": 1.5,
-        "max_namer_rest": 0.0,
+        "max_namer_rest": 0.0, "namer_hidden_sizes": 64, "namer_stride": 0,
         "viterbi_lag": 1.5, "memory": 3, "device": 0, "n_threads": 0,
         "random_state": "seed", "verbose": "loud", "stream_past": -1,
         "stream_future": 2.5, "lookahead": -1, "fit_threads": "every",

@@ -428,14 +428,21 @@ def test_novel_runs_stream_exactly(exact_model):
         assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
 
 
-def test_named_runs_stream_exactly():
-    # the run namer names each run once it has ended, from its own rows: the
-    # live events are the offline ones (docs/design.md, "The run namer")
+@pytest.mark.parametrize("stride", [1, 2])
+def test_named_runs_stream_exactly(stride):
+    # the run namer names each run once it has ended, from its own rows (with
+    # a stride, every phase of them): the live events are the offline ones
+    # (docs/design.md, "The run namer")
     import copy
 
     pipe, X = _exact_pipeline(
-        n_sequences=7, max_epochs=6, namer="gru", namer_weight=0.9
+        n_sequences=7,
+        max_epochs=6,
+        namer="gru",
+        namer_weight=0.9,
+        namer_stride=stride,
     )
+    assert pipe[-1].namer_stride_ == stride
     F = pipe[:-1].transform(X)
     named = pipe[-1].predict_segments(F)
     plain = copy.deepcopy(pipe[-1]).set_params(namer_weight=0.0).predict_segments(F)
@@ -454,7 +461,7 @@ def test_named_runs_stream_exactly():
     tagger = pipe[-1]
     args = (tagger.namer_.module_, tagger.namer_mean_, tagger.namer_scale_)
     rest = [
-        np.exp(namer_scores(*args, f[int(s) : int(e)], len(tagger.classes_))[0])
+        np.exp(namer_scores(*args, f[int(s) : int(e)], len(tagger.classes_), stride)[0])
         for f, segments in zip(F, named)
         for _, s, e, _ in segments
     ]

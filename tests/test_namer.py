@@ -12,7 +12,7 @@ import warnings
 import joblib
 import numpy as np
 import pytest
-from numpy.testing import assert_array_equal
+from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.base import clone
 
 torch = pytest.importorskip("torch")
@@ -29,9 +29,11 @@ from skgesture._taggers._decoding import (  # noqa: E402
 from skgesture._taggers._namer import (  # noqa: E402
     gesture_windows,
     name_run,
+    namer_batch,
     namer_of,
     namer_scores,
     rest_windows,
+    strided,
 )
 from skgesture.metrics import jaccard_index  # noqa: E402
 from skgesture.utils._segments import runs  # noqa: E402
@@ -83,6 +85,46 @@ def test_rest_windows_lie_in_rest_runs_with_gesture_lengths():
     assert rest_windows(X[:1], [np.ones(len(y), dtype=int)], [4], 5, 0) == ([], [])
     assert rest_windows(X, [y, y[:6]], [], 5, 0) == ([], [])
     assert rest_windows(X, [y, y[:6]], [4], 0, 0) == ([], [])
+
+
+def test_strided_windows_keep_every_stride_th_row_from_a_random_phase():
+    W = [np.arange(n, dtype=np.float32)[:, None] for n in (9, 8, 1, 5) * 5]
+    Y = [np.arange(len(w)) + 100 for w in W]
+    assert strided(W, Y, 1, 0) == (W, Y)  # stride 1: the windows themselves
+    got, labels = strided(W, Y, 3, 0)
+    phases = set()
+    for w, v, g, lab in zip(W, Y, got, labels):
+        p = int(g[0, 0])
+        phases.add(p)
+        # rows p, p + 3, ... of the window, and their own labels
+        assert_array_equal(g[:, 0], w[p::3, 0])
+        assert_array_equal(lab, v[p::3])
+        assert len(g) >= 1  # a window shorter than its phase keeps its first row
+    assert phases == {0, 1, 2}
+    again = strided(W, Y, 3, 0)[0]
+    assert all(np.array_equal(a, b) for a, b in zip(got, again))  # seeded
+
+
+def test_a_strided_namer_reads_every_stride_th_row_from_the_first():
+    from skgesture._nn._modules import RecurrentTaggerModule
+
+    torch.manual_seed(0)
+    module = RecurrentTaggerModule(3, 4, hidden_sizes=(5,))
+    mean, scale = np.zeros(3, np.float32), np.ones(3, np.float32)
+    rng = np.random.default_rng(0)
+    windows = [rng.normal(size=(n, 3)).astype(np.float32) for n in (7, 1, 10, 2)]
+    got = namer_batch(module, mean, scale, windows, 4, stride=2)
+    # rows 0, 2, 4, ... of every run, read as the run
+    want = namer_batch(module, mean, scale, [w[::2] for w in windows], 4)
+    assert_allclose(got, want, atol=1e-6)
+    for w, score in zip(windows, got):
+        # one run alone (a stream's call) is the batch's, to float rounding
+        assert_allclose(namer_scores(module, mean, scale, w, 4, 2), score, atol=1e-5)
+    # stride 1 reads every row, as before
+    plain = namer_batch(module, mean, scale, windows, 4)
+    assert_allclose(namer_batch(module, mean, scale, windows, 4, stride=1), plain)
+    assert not np.allclose(got[0], plain[0])  # the stride reads another sequence
+    assert_allclose(got[1], plain[1])  # a one-row run is its first row either way
 
 
 def test_a_run_is_named_by_the_weighted_scores_never_rest():
@@ -327,6 +369,31 @@ def test_namer_weight_is_validated():
         SequenceTagger(max_namer_rest=1.5, namer="gru").fit(X, y)
     with pytest.raises(ValueError, match="max_namer_rest=0.5 reads the run namer"):
         SequenceTagger(max_namer_rest=0.5).fit(X, y)
+    with pytest.raises(ValueError, match="namer_stride"):
+        SequenceTagger(namer="gru", namer_stride=0).fit(X, y)
+    for bad in [(), (8, 0), (True,)]:
+        with pytest.raises(ValueError, match=r"namer_hidden_sizes must be a non-empty"):
+            SequenceTagger(namer="gru", namer_hidden_sizes=bad).fit(X, y)
+
+
+def test_a_strided_namer_names_gestures_that_differ_at_their_end(late_pair):
+    # reading every second frame of a run, from both phases, the namer still
+    # tells the pair apart by their ends; its stride is fitted with it
+    tagger, X, y = late_pair
+    X_tr, y_tr = (part[:10] for part in _late_pair(14, 0))
+    wide = clone_with(tagger, namer_stride=2, namer_hidden_sizes=(16,))
+    with torch.random.fork_rng(devices=[]):
+        wide.fit(X_tr, y_tr)
+    assert wide.namer_stride_ == 2
+    assert [rnn.hidden_size for rnn in wide.namer_.module_.layers] == [16]
+    causal = jaccard_index(y, clone_with(wide, namer_weight=0.0).predict(X))
+    named = jaccard_index(y, wide.predict(X))
+    assert named > 0.9 and named > causal + 0.1
+    # the decoding reads the fitted stride, not the parameter
+    assert_array_equal(
+        np.concatenate(wide.predict(X)),
+        np.concatenate(clone_with(wide, namer_stride=1).predict(X)),
+    )
 
 
 def test_the_rest_rule_needs_a_namer_trained_on_rest(late_pair):

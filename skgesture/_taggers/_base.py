@@ -159,10 +159,11 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
         mean, scale = self.namer_mean_, self.namer_scale_
         threads = getattr(self, "n_threads", None)
         scores = namer_batch if batch else namer_scores
+        stride = getattr(self, "namer_stride_", 1)  # 1: fitted before the stride
 
         def score(rows):
             with torch_threads(threads):
-                return scores(module, mean, scale, rows, n_classes)
+                return scores(module, mean, scale, rows, n_classes, stride)
 
         return score
 

@@ -27,7 +27,7 @@ NAMER_JITTER = 0.1  # sd of a jittered end, as a fraction of the gesture's lengt
 NAMER_REST = 0.25  # rest windows per gesture window (the rest class of the namer)
 NAMER_NEGATIVES = 0.25  # more rest windows per gesture window, from namer_only data
 MIN_REST = 4  # shortest rest run that rest windows are drawn from, in frames
-NAMER_HIDDEN = (64,)  # units per direction of the namer's one GRU layer
+NAMER_HIDDEN = (64,)  # SequenceTagger's default namer_hidden_sizes
 # The namer's own training: short windows, larger batches, half the tagger's
 # epochs (its steps per epoch; 300 steps for the recommended model's 600).
 NAMER_TRAINING = {
@@ -158,6 +158,45 @@ def rest_windows(X, y_idx, lengths, n_windows, seed):
     return windows, labels
 
 
+def strided(windows, labels, stride, seed):
+    """Every ``stride``-th row of each training window, from a random first
+    row (its phase), as the namer reads a run with ``namer_stride``
+    (:func:`namer_batch` reads a run from its first row; the random phases
+    of training are an augmentation).
+
+    Parameters
+    ----------
+    windows : list of ndarray
+    labels : list of ndarray
+    stride : int
+        1 returns the windows unchanged.
+    seed : int
+        Seed of the phases.
+
+    Returns
+    -------
+    windows : list of ndarray
+    labels : list of ndarray
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skgesture._taggers._namer import strided
+    >>> W, Y = strided([np.arange(7.0)[:, None]], [np.ones(7, int)], 2, 0)
+    >>> W[0].ravel().tolist(), Y[0].tolist()  # the phase drawn: 1
+    ([1.0, 3.0, 5.0], [1, 1, 1])
+    """
+    if stride == 1:
+        return windows, labels
+    rng = np.random.default_rng(seed)
+    phases = rng.integers(0, stride, size=len(windows))
+    pairs = [
+        (w[p::stride], y[p::stride]) if len(w) > p else (w[:1], y[:1])
+        for w, y, p in zip(windows, labels, phases.tolist())
+    ]
+    return [w for w, _ in pairs], [y for _, y in pairs]
+
+
 def name_run(raw, namer_scores, weight):
     """Column of the name of one run: the gesture column with the highest
     ``(1 - weight) * log(mean raw probability) + weight * namer_scores``
@@ -193,7 +232,7 @@ def name_run(raw, namer_scores, weight):
     return int(np.argmax(score))
 
 
-def namer_scores(module, mean, scale, rows, n_classes):
+def namer_scores(module, mean, scale, rows, n_classes, stride=1):
     """The namer's log mean probabilities over ``rows`` (one run): the
     :func:`namer_batch` of one run, as a stream computes it when the run ends.
 
@@ -206,15 +245,19 @@ def namer_scores(module, mean, scale, rows, n_classes):
     rows : ndarray of shape (n_rows, n_features)
         The run's feature rows.
     n_classes : int
+    stride : int, default=1
+        The namer reads every ``stride``-th row from the run's first
+        (``namer_stride_``; rows ``0, stride, 2 * stride, ...``), and the
+        mean is over the rows it read.
 
     Returns
     -------
     ndarray of shape (n_classes,)
     """
-    return namer_batch(module, mean, scale, [rows], n_classes)[0]
+    return namer_batch(module, mean, scale, [rows], n_classes, stride)[0]
 
 
-def namer_batch(module, mean, scale, windows, n_classes):
+def namer_batch(module, mean, scale, windows, n_classes, stride=1):
     """:func:`namer_scores` of several runs in one packed forward pass.
 
     Offline, every run of a ``predict`` call is named in one pass (3 times
@@ -230,6 +273,7 @@ def namer_batch(module, mean, scale, windows, n_classes):
 
     if not windows:
         return np.zeros((0, n_classes))
+    windows = [w[::stride] for w in windows]  # (stride 1: the rows themselves)
     lengths = np.array([len(w) for w in windows])
     # Packed layout built directly (no padded copy): windows sorted longest
     # first; row t of the window ranked r sits at ``first[t] + r``.

@@ -33,6 +33,7 @@ from skgesture._taggers._namer import (
     NAMER_TRAINING,
     gesture_windows,
     rest_windows,
+    strided,
 )
 from skgesture.utils import PoseNovelty, check_sequence_labels, check_sequences
 from skgesture.utils._fitting import fit_cached, seed_from
@@ -166,8 +167,9 @@ class SequenceTagger(_BaseTagger):
         Frames between a frame and the path's decision on it (added to the
         stream's delay).
     namer : {"gru"} or None, default=None
-        ``"gru"``: also train a run namer, a bidirectional GRU (one layer of
-        64 units a direction) on the training gestures (each gesture and
+        ``"gru"``: also train a run namer, a bidirectional GRU
+        (``namer_hidden_sizes``, reading every ``namer_stride``-th frame) on
+        the training gestures (each gesture and
         copies of it with jittered ends) and on windows of rest (one for
         every four gesture windows, from the rest of the training sequences
         and of any background recording; see ``max_namer_rest``), for half
@@ -178,7 +180,7 @@ class SequenceTagger(_BaseTagger):
         first frames of a gesture before its end is seen; the namer reads the
         end, and the run rules judge a run only once it has ended, so the
         stream stays exact (a gesture followed at once by another is emitted
-        when the second ends). About 10-12 s more per fit of the recommended
+        when the second ends). About 12 s more per fit of the recommended
         model on 2 cores (docs/design.md, "The run namer"). None: no namer.
     namer_weight : float, default=0.75
         Decision parameter of the namer: a run is named by the gesture class
@@ -191,6 +193,18 @@ class SequenceTagger(_BaseTagger):
         gives a mean probability of rest above ``max_namer_rest`` becomes
         rest (motion unlike every gesture, read from all of its frames); in
         (0, 1]. None: the namer's rest is not read. Needs ``namer``.
+    namer_hidden_sizes : tuple of int, default=(64,)
+        Units per direction of each of the namer's GRU layers (the
+        recommended model's namer has one layer of 128). Needs ``namer``.
+    namer_stride : int, default=1
+        The namer reads every ``namer_stride``-th frame of a gesture: each
+        training window is thinned from a random first frame, and a run is
+        read once per phase (frames ``p, p + stride, ...`` for every ``p``
+        below the stride) and named by the mean over all of its frames. At
+        30 frames a second, consecutive frames are nearly alike: the
+        recommended model's 2 halves the namer's training time at no
+        measured cost, which pays for a namer twice as wide
+        (docs/design.md, "The run namer"). Needs ``namer``.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a network reading a window (the TCN, or
@@ -247,6 +261,9 @@ class SequenceTagger(_BaseTagger):
     namer_rest_ : int
         With ``namer``: the rest windows the namer was trained on (0 when
         the training data had no rest).
+    namer_stride_ : int
+        With ``namer``: the ``namer_stride`` the namer was trained with, the
+        one its decoding reads (changing ``namer_stride`` needs a refit).
     mean_ : ndarray of shape (n_features,)
         Training mean of every feature.
     scale_ : ndarray of shape (n_features,)
@@ -330,6 +347,8 @@ class SequenceTagger(_BaseTagger):
         "namer": [StrOptions({"gru"}), None],
         "namer_weight": [Interval(Real, 0, 1, closed="both")],
         "max_namer_rest": [Interval(Real, 0, 1, closed="right"), None],
+        "namer_hidden_sizes": [tuple, list],
+        "namer_stride": [Interval(Integral, 1, None, closed="left")],
         **_DECODING_CONSTRAINTS,
         **_STREAM_CONSTRAINTS,
         "memory": [None, str, HasMethods(["cache"])],
@@ -381,6 +400,8 @@ class SequenceTagger(_BaseTagger):
         namer=None,
         namer_weight=0.75,
         max_namer_rest=None,
+        namer_hidden_sizes=NAMER_HIDDEN,
+        namer_stride=1,
         stream_past=32,
         stream_future=8,
         memory=None,
@@ -424,6 +445,8 @@ class SequenceTagger(_BaseTagger):
         self.namer = namer
         self.namer_weight = namer_weight
         self.max_namer_rest = max_namer_rest
+        self.namer_hidden_sizes = namer_hidden_sizes
+        self.namer_stride = namer_stride
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.memory = memory
@@ -458,15 +481,15 @@ default=None
         self : SequenceTagger
             The fitted tagger.
         """
-        hidden = self.hidden_sizes
-        if len(hidden) == 0 or not all(
-            isinstance(h, Integral) and not isinstance(h, bool) and h >= 1
-            for h in hidden
-        ):
-            raise ValueError(
-                "hidden_sizes must be a non-empty tuple of positive ints, got "
-                f"{hidden!r}"
-            )
+        for name in ("hidden_sizes", "namer_hidden_sizes"):
+            hidden = getattr(self, name)
+            if len(hidden) == 0 or not all(
+                isinstance(h, Integral) and not isinstance(h, bool) and h >= 1
+                for h in hidden
+            ):
+                raise ValueError(
+                    f"{name} must be a non-empty tuple of positive ints, got {hidden!r}"
+                )
         if self.lookahead is not None and self.architecture != "tcn":
             raise ValueError(
                 f"lookahead={self.lookahead} bounds the look-ahead of a temporal "
@@ -490,7 +513,13 @@ default=None
         self._class_weight = _class_weights(self.class_weight, y_idx, len(classes))
         X = [x.astype(np.float32) for x in X]
         self._fit_network(X, y_idx, classes)
-        for name in ("namer_", "namer_mean_", "namer_scale_", "namer_rest_"):
+        for name in (
+            "namer_",
+            "namer_mean_",
+            "namer_scale_",
+            "namer_rest_",
+            "namer_stride_",
+        ):
             self.__dict__.pop(name, None)  # a refit without a namer
         if self.namer is not None:
             self._fit_namer(X, y_idx, classes, negatives)
@@ -562,6 +591,9 @@ default=None
                 seed + 2,
             )
             rest, rest_labels = rest + more, rest_labels + more_labels
+        stride = int(self.namer_stride)
+        windows, labels = strided(windows, labels, stride, seed + 3)
+        rest, rest_labels = strided(rest, rest_labels, stride, seed + 4)
         if not rest and self.max_namer_rest is not None:
             warnings.warn(
                 f"max_namer_rest={self.max_namer_rest} reads the run namer's rest, "
@@ -575,7 +607,7 @@ default=None
         network = _CropNet(
             n_classes=len(classes),
             architecture=self.namer,
-            hidden_sizes=NAMER_HIDDEN,
+            hidden_sizes=tuple(int(h) for h in self.namer_hidden_sizes),
             augmenter=None if self.augment is None else clone(self.augment),
             standardize=True,
             **params,
@@ -586,6 +618,7 @@ default=None
             )
         self.namer_ = fitted.net_
         self.namer_rest_ = len(rest)
+        self.namer_stride_ = stride
         self.namer_mean_ = fitted.mean_
         self.namer_scale_ = fitted.scale_
 
