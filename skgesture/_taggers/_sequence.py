@@ -198,13 +198,13 @@ class SequenceTagger(_BaseTagger):
         recommended model's namer has one layer of 128). Needs ``namer``.
     namer_stride : int, default=1
         The namer reads every ``namer_stride``-th frame of a gesture: each
-        training window is thinned from a random first frame, and a run is
-        read once per phase (frames ``p, p + stride, ...`` for every ``p``
-        below the stride) and named by the mean over all of its frames. At
-        30 frames a second, consecutive frames are nearly alike: the
-        recommended model's 2 halves the namer's training time at no
-        measured cost, which pays for a namer twice as wide
-        (docs/design.md, "The run namer"). Needs ``namer``.
+        training window is thinned from a random first frame (an
+        augmentation), and a run is read from its first frame (frames ``0,
+        stride, 2 * stride, ...``), offline as live. At 30 frames a second,
+        consecutive frames are nearly alike: the recommended model's 2
+        halves the namer's training and prediction time at no measured
+        cost, which pays for a namer twice as wide (docs/design.md, "The run
+        namer"). Needs ``namer``.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a network reading a window (the TCN, or
