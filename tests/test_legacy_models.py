@@ -161,6 +161,10 @@ STREAM_ROUNDING = {"recommended"}
 # same Conv1d parameters) rather than torch's conv1d, so its probabilities
 # equal 0.1's to float32 rounding, and its labels and segments are identical.
 TCN_ROUNDING = {"recommended"}
+# Method C's BiLSTM runs torch's CPU LSTM kernels, whose float32 sums follow the
+# CPU's instruction set: on an AVX-512 Xeon (2026-12-07) its probabilities were
+# 1.8e-7 from 0.1's and its events' confidences 2.3e-8, its labels identical.
+CPU_ROUNDING = {"method_c"}
 # the columns of those outputs that are probabilities (segments and events:
 # class, start, end, confidence[, emitted_at]; the segmenter's decision and
 # predict_proba: all, None)
@@ -190,6 +194,7 @@ def test_legacy_model_gives_identical_outputs(name, kind, stored):
                 name in FLOAT32_ROUNDING
                 or (name in STREAM_ROUNDING and quantity == "stream")
                 or name in TCN_ROUNDING
+                or name in CPU_ROUNDING
             )
             if rounded_here and quantity in ROUNDED_COLUMNS:
                 # labels and frames exactly; probabilities and confidences to
