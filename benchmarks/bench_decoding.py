@@ -193,6 +193,8 @@ PARAMS = (
     "viterbi_penalty",
     "max_novelty",
     "viterbi_lag",
+    "viterbi_decision",
+    "viterbi_duration",
     "namer_weight",
     "max_namer_rest",
 )
@@ -210,7 +212,9 @@ GRID = {
 VARY = {
     **GRID,
     "max_novelty": (None, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0),
-    "viterbi_lag": (0, 1, 2, 3, 4, 6, 8),
+    "viterbi_lag": (0, 1, 2, 3, 4, 6, 8, 12),
+    "viterbi_decision": ("frame", "run"),
+    "viterbi_duration": (0.5, 0.7, 0.85, 1.0),
     "namer_weight": (0.0, 0.1, 0.25, 0.4, 0.5, 0.75, 1.0),  # 0: no renaming
     # None: the namer's rest is not read
     "max_namer_rest": (None, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.8),
@@ -391,7 +395,14 @@ def path_settings():
     """The settings of ``GRID`` and ``VARY`` that move the runs the run
     rules judge (smoothing, path, ``min_run``), the others at the default."""
     default = current_default()
-    moving = ("smooth_span", "min_run", "viterbi_penalty", "viterbi_lag")
+    moving = (
+        "smooth_span",
+        "min_run",
+        "viterbi_penalty",
+        "viterbi_lag",
+        "viterbi_decision",
+        "viterbi_duration",
+    )
     grid = [dict(zip(moving, v)) for v in itertools.product(
         *[GRID.get(p, (default[p],)) for p in moving])]  # fmt: skip
     vary = [{p: v} for p in moving for v in VARY.get(p, ())]
@@ -549,7 +560,9 @@ def load_cell(path):
 
 def fmt_value(value):
     """A parameter's value in the table: ``"off"`` for None."""
-    return "off" if value is None else f"{value:g}"
+    if value is None:
+        return "off"
+    return value if isinstance(value, str) else f"{value:g}"
 
 
 def settings_of(grid):

@@ -29,6 +29,8 @@ LOOKAHEAD = 8  # frames of future the tagger reads
 MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short gesture
 MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
 VITERBI_PENALTY = 5.0  # the duration-aware path: nats to enter a gesture
+VITERBI_DECISION = "run"  # a gesture's frames decided once it ends (docs/design.md)
+VITERBI_LAG = 4  # frames between a rest frame and its decision
 MAX_NOVELTY = 1.75  # runs whose poses are this far from their class's are rest
 NAMER_WEIGHT = 0.75  # the run namer's share of a run's name (docs/design.md)
 NAMER_UNITS = (128,)  # the run namer's GRU: one layer of 128 units a direction
@@ -271,9 +273,10 @@ def make_recommended(
     lookahead : int or None, default=8
         An int ``L``: the model that streams exactly. The TCN's convolutions
         are causal, its output for a frame read ``L`` frames later
-        (``tagger__lookahead``), and the joint features take their statistics
-        as live (``features__statistics="running"``; the descriptor's live
-        rows are its offline ones already), so that
+        (``tagger__lookahead``), and the features are computed as live: an
+        untracked frame takes the last tracked pose (``features__fill="hold"``)
+        and the joint features take running statistics
+        (``features__statistics="running"``), so that
         :class:`~skgesture.streaming.StreamingRecognizer` gives the offline
         events, ``L`` plus the decoding's look-ahead frames behind. None: the
         TCN reads whole sequences, better offline on PRECOG; live it runs on a
@@ -325,8 +328,12 @@ default="synthetic"
     (docs/safety.md, "The decoding rules"). The labels are the duration-aware
     Viterbi path (``tagger__viterbi_penalty=5``: entering a gesture costs 5
     nats, a gesture lasts at least 0.7 of its class's short gesture, the 10th
-    percentile of the class's lengths in ``fit``), decided 6 frames after
-    each frame (``tagger__viterbi_lag``), offline as live. Then a run shorter
+    percentile of the class's lengths in ``fit``), offline as live: a rest
+    frame is decided 4 frames after it (``tagger__viterbi_lag``), and the
+    frames of a gesture together once it has ended, from the path that has
+    read all of it (``tagger__viterbi_decision="run"``; docs/design.md,
+    "Duration-aware decoding"). Untracked frames take the last tracked pose
+    (``features__fill="hold"``), as they must live. Then a run shorter
     than 0.5 of its class's short gesture (``tagger__min_duration``) or
     longer than 2.5 times its long gesture (``tagger__max_duration``; the
     90th percentile) is rest, and so is a run whose poses are far from the
@@ -368,7 +375,9 @@ default="synthetic"
     else:
         # The descriptor is built from angles and distances: rotating or
         # scaling its 183/426 values as coordinates would be meaningless.
-        step = PoseDescriptor(joints=joints)
+        # Live, an untracked frame is the last tracked one (the future is
+        # unknown): offline does the same, so that the stream is exact.
+        step = PoseDescriptor(joints=joints, fill=live.get("fill", "linear"))
         augment = SkeletonAugmenter(rotation=0.0, scale=0.0, time_warp=0.2, noise=0.02)
     tagger = SequenceTagger(
         architecture="tcn",
@@ -388,6 +397,8 @@ default="synthetic"
         max_duration=MAX_DURATION,
         max_novelty=MAX_NOVELTY,
         viterbi_penalty=VITERBI_PENALTY,
+        viterbi_decision=VITERBI_DECISION,
+        viterbi_lag=VITERBI_LAG,
         namer="gru",
         namer_weight=NAMER_WEIGHT,
         max_namer_rest=MAX_NAMER_REST,

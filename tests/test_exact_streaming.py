@@ -306,14 +306,22 @@ def test_make_recommended_with_a_lookahead_streams_exactly(features):
     )
     if features == "joints":
         assert model.named_steps["features"].statistics == "running"
+    # trained enough to find the gestures it is compared on
     model.set_params(
-        tagger__hidden_sizes=(8,), tagger__tcn_layers=4, tagger__tcn_stages=2,
-        tagger__max_epochs=3, tagger__steps_per_epoch=5, tagger__crop_length=64,
+        tagger__hidden_sizes=(16,), tagger__tcn_layers=4, tagger__tcn_stages=2,
+        tagger__max_epochs=6, tagger__steps_per_epoch=10, tagger__crop_length=64,
+        tagger__learning_rate=1e-2, tagger__namer_hidden_sizes=(16,),
     )  # fmt: skip
+    # live, an untracked frame is the last tracked one: offline too
+    assert model.named_steps["features"].fill == "hold"
     with torch.random.fork_rng(devices=[]):
         model.fit(data.X[:4], data.y[:4])
-    x = data.X[4]
+    x = data.X[4].copy()
+    inside = np.flatnonzero(data.y[4])[10]
+    x[inside : inside + 8] = 0.0  # lost tracking inside a gesture (interpolated
+    # offline, fill="linear", its event here differs from the live one by a frame)
     segments = model[-1].predict_segments(model[:-1].transform([x]))[0]
+    assert len(segments) >= 2
     events = StreamingRecognizer(model).recognize(x)
     got = np.array([(e.label, e.start, e.end) for e in events]).reshape(-1, 3)
     assert_array_equal(got, segments[:, :3].astype(int))
@@ -372,10 +380,11 @@ def test_rejected_runs_stream_exactly(exact_model):
         assert_allclose([e.confidence for e in events], segments[:, 3], atol=1e-5)
 
 
-@pytest.mark.parametrize("lag", [0, 6])
-def test_the_viterbi_path_streams_exactly(exact_model, lag):
-    # the duration-aware path is decided at a fixed lag by the same steps
-    # offline and live: the events equal predict_segments, lag frames later
+@pytest.mark.parametrize(("lag", "decision"), [(0, "frame"), (6, "frame"), (6, "run")])
+def test_the_viterbi_path_streams_exactly(exact_model, lag, decision):
+    # the duration-aware path is decided at a fixed lag (or a gesture's frames
+    # once it ends) by the same steps offline and live: the events equal
+    # predict_segments, lag frames after their end
     import copy
 
     pipe = copy.deepcopy(exact_model[0])
@@ -383,7 +392,12 @@ def test_the_viterbi_path_streams_exactly(exact_model, lag):
     tagger = pipe[-1]
     F = pipe[:-1].transform(X)
     plain = tagger.predict(F)
-    tagger.set_params(viterbi_penalty=3.0, viterbi_duration=0.7, viterbi_lag=lag)
+    tagger.set_params(
+        viterbi_penalty=3.0,
+        viterbi_duration=0.7,
+        viterbi_lag=lag,
+        viterbi_decision=decision,
+    )
     after = tagger.predict_segments(F)
     assert any(not np.array_equal(a, b) for a, b in zip(plain, tagger.predict(F)))
     delays = []

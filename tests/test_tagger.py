@@ -564,7 +564,11 @@ def test_make_recommended_default_streams_exactly_on_the_descriptor():
     # the default is chosen by its worst case among exactly streaming models
     model = make_recommended(joints="paper11", random_state=0)
     assert type(model.steps[0][1]).__name__ == "PoseDescriptor"
+    assert model.steps[0][1].fill == "hold"  # untracked frames as live
     assert model.steps[-1][1].lookahead == 8
+    assert model.steps[-1][1].viterbi_decision == "run"
+    assert model.steps[-1][1].viterbi_lag == 4
+    assert make_recommended(lookahead=None).steps[0][1].fill == "linear"
     offline = make_recommended(features="joints", lookahead=None)
     assert offline.steps[-1][1].lookahead is None
     assert offline.steps[0][1].statistics == "sequence"

@@ -68,6 +68,7 @@ _DECODING_CONSTRAINTS = {
     "viterbi_penalty": [None, Interval(Real, 0, None, closed="left")],
     "viterbi_duration": [Interval(Real, 0, None, closed="left")],
     "viterbi_lag": [Interval(Integral, 0, None, closed="left")],
+    "viterbi_decision": [StrOptions({"frame", "run"})],
 }
 
 _STREAM_CONSTRAINTS = {
@@ -322,6 +323,7 @@ class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
                     chain_lengths(fitted, getattr(self, "viterbi_duration", 0.0)),
                     penalty,
                     getattr(self, "viterbi_lag", 0),
+                    getattr(self, "viterbi_decision", "frame"),
                 )
         longest = getattr(self, "max_duration", None)
         max_lengths = None

@@ -419,16 +419,20 @@ class ViterbiRule:
         Log score of entering a gesture.
     lag : int
         Frames between a frame and its decision.
+    decision : {"frame", "run"}, default="frame"
+        When a gesture's frames are decided
+        (:class:`~skgesture._taggers._viterbi.ViterbiPath`).
     """
 
-    def __init__(self, durations, penalty, lag):
+    def __init__(self, durations, penalty, lag, decision="frame"):
         self.durations = np.asarray(durations, dtype=np.int64)
         self.penalty = float(penalty)
         self.lag = int(lag)
+        self.decision = decision
 
     def path(self):
         """A fresh :class:`~skgesture._taggers._viterbi.ViterbiPath`."""
-        return ViterbiPath(self.durations, self.penalty, self.lag)
+        return ViterbiPath(self.durations, self.penalty, self.lag, self.decision)
 
 
 def decode(
@@ -738,9 +742,10 @@ class LabelRuns:
         self.rest.append(rest)
         if self.path is None:
             labels = best_path(smoothed, self.classes)
-        else:  # the rows decided by these: lag rows earlier
-            labels = self.classes[self.path.feed(log_scores(smoothed, rest))]
-            times = np.asarray(times)[len(times) - len(labels) :]
+        else:  # the rows decided by these (lag rows earlier, or held)
+            decided, owner = self.path.feed_owned(log_scores(smoothed, rest))
+            labels = self.classes[decided]
+            times = np.asarray(times)[owner]
         return self._label(labels, times)
 
     def _label(self, labels, times):

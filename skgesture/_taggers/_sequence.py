@@ -166,6 +166,15 @@ class SequenceTagger(_BaseTagger):
     viterbi_lag : int, default=6
         Frames between a frame and the path's decision on it (added to the
         stream's delay).
+    viterbi_decision : {"frame", "run"}, default="frame"
+        When the path decides a frame (with ``viterbi_penalty``).
+        ``"frame"``: ``viterbi_lag`` frames after it. ``"run"``: a frame the
+        path reads as rest then, but the frames of a gesture together, once
+        the path reads a frame after them as rest, from the best path of that
+        moment, which has read the whole gesture: its class no longer changes
+        midway because its first frames looked like another gesture. A
+        gesture's event waits for its end either way, so the stream's delay
+        is the same (docs/design.md, "Duration-aware decoding").
     namer : {"gru"} or None, default=None
         ``"gru"``: also train a run namer, a bidirectional GRU
         (``namer_hidden_sizes``, reading every ``namer_stride``-th frame) on
@@ -397,6 +406,7 @@ class SequenceTagger(_BaseTagger):
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
+        viterbi_decision="frame",
         namer=None,
         namer_weight=0.75,
         max_namer_rest=None,
@@ -442,6 +452,7 @@ class SequenceTagger(_BaseTagger):
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag
+        self.viterbi_decision = viterbi_decision
         self.namer = namer
         self.namer_weight = namer_weight
         self.max_namer_rest = max_namer_rest

@@ -69,6 +69,10 @@ class VotingTagger(_BaseTagger):
     viterbi_lag : int, default=6
         Frames between a frame and the path's decision on it (added to the
         stream's delay).
+    viterbi_decision : {"frame", "run"}, default="frame"
+        When the path decides a frame, as in
+        :class:`~skgesture.SequenceTagger`: ``viterbi_lag`` frames after it, or
+        (``"run"``) a gesture's frames together once it has ended.
     stream_past : int, default=32
         Streaming only (:class:`~skgesture.streaming.StreamingRecognizer`):
         frames before a frame that a member reading a window (a TCN, or any
@@ -144,6 +148,7 @@ class VotingTagger(_BaseTagger):
         viterbi_penalty=None,
         viterbi_duration=0.7,
         viterbi_lag=6,
+        viterbi_decision="frame",
         stream_past=32,
         stream_future=8,
         n_threads=1,
@@ -161,6 +166,7 @@ class VotingTagger(_BaseTagger):
         self.viterbi_penalty = viterbi_penalty
         self.viterbi_duration = viterbi_duration
         self.viterbi_lag = viterbi_lag
+        self.viterbi_decision = viterbi_decision
         self.stream_past = stream_past
         self.stream_future = stream_future
         self.n_threads = n_threads
