@@ -15,6 +15,8 @@ import numpy as np
 from sklearn.base import BaseEstimator
 from sklearn.utils._param_validation import Interval, validate_params
 
+from skgesture.utils._params import NewParamsMixin
+
 __all__ = ["SkeletonAugmenter", "time_warp"]
 
 N_COORDS = 3
@@ -86,7 +88,7 @@ def _interpolate(x, lo, w):
     return x[lo] * (1 - w) + x[lo + 1] * w
 
 
-class SkeletonAugmenter(BaseEstimator):
+class SkeletonAugmenter(NewParamsMixin, BaseEstimator):
     """Random perturbations of a training sequence of xyz-triple features.
 
     Each call draws a rotation about the vertical axis, a global scale, a

@@ -25,6 +25,7 @@ from skgesture.utils._buffers import (
     RunningMedian,
     _concat_rows,
 )
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
     check_skeletons,
     check_stream_frames,
@@ -170,7 +171,7 @@ def _with_derivatives(flat, velocities, accelerations):
     return np.hstack(parts).astype(np.float32)
 
 
-class JointFeatures(StreamableMixin, TransformerMixin, BaseEstimator):
+class JointFeatures(NewParamsMixin, StreamableMixin, TransformerMixin, BaseEstimator):
     """Body-normalised joint positions and velocities of every frame.
 
     Per sequence: untracked frames are filled (as :class:`PoseDescriptor`

@@ -26,6 +26,7 @@ from skgesture._rate import (
     same_rate,
     segments_back,
 )
+from skgesture.utils._params import NewParamsMixin
 
 __all__ = ["GesturePipeline"]
 
@@ -58,7 +59,7 @@ def _sequence_rates(fps, n, what):
     return [check_fps(r, f"{what}[{i}]") for i, r in enumerate(rates)]
 
 
-class GesturePipeline(Pipeline):
+class GesturePipeline(NewParamsMixin, Pipeline):
     """A scikit-learn ``Pipeline`` that knows the frame rate it was trained at.
 
     Every model of the toolkit counts time in frames (the paper's Gaussian of 5

@@ -14,6 +14,7 @@ from skgesture._nn._mlp import TorchMLPClassifier, fast_proba
 from skgesture._stream import Rows, StreamableMixin
 from skgesture.utils._buffers import RowBuffer, _concat_rows
 from skgesture.utils._fitting import fit_inner_estimator
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, loess_smooth
 from skgesture.utils._validation import (
@@ -84,6 +85,7 @@ def context_mask(y, n_context):
 
 
 class ActivitySegmenter(
+    NewParamsMixin,
     StreamableMixin,
     ClassifierMixin,
     TransformerMixin,

@@ -10,6 +10,7 @@ from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
 from skgesture._stream import Rows, StreamableMixin
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
     SequenceOf,
     check_sequences,
@@ -313,7 +314,11 @@ def check_lazy_windows(X, steps, n_poses, estimator, reset):
 
 
 class DynamicPoseWindow(
-    StreamableMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+    NewParamsMixin,
+    StreamableMixin,
+    TransformerMixin,
+    BaseEstimator,
+    auto_wrap_output_keys=None,
 ):
     """Dynamic poses: the descriptors at ``t - s``, ``t``, ``t + s`` for every frame.
 

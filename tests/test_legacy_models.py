@@ -176,13 +176,21 @@ ROUNDED_COLUMNS = {
 }
 
 
+def _load_fixture(name, kind):
+    path = FIXTURES / f"{name}.{kind}"
+    return _load_skg(path) if kind == "skg" else joblib.load(path)
+
+
+every_fixture = pytest.mark.parametrize(
+    ("name", "kind"), [(n, k) for n in NAMES for k in ("skg", "joblib")]
+)
+
+
 @needs_fixture_libraries
-@pytest.mark.parametrize("kind", ["skg", "joblib"])
-@pytest.mark.parametrize("name", NAMES)
+@every_fixture
 def test_legacy_model_gives_identical_outputs(name, kind, stored):
     X, expected = stored
-    path = FIXTURES / f"{name}.{kind}"
-    model = _load_skg(path) if kind == "skg" else joblib.load(path)
+    model = _load_fixture(name, kind)
     got = _outputs(model, X, QUANTITIES[name])
     assert set(got) == QUANTITIES[name]
     for quantity, want in expected[name].items():
@@ -207,6 +215,24 @@ def test_legacy_model_gives_identical_outputs(name, kind, stored):
                 np.testing.assert_allclose(a, b, rtol=0, atol=1e-6, err_msg=where)
             else:
                 assert np.array_equal(a, b), where
+
+
+@needs_fixture_libraries
+@every_fixture
+def test_legacy_model_can_be_tuned_and_cloned(name, kind, stored):
+    # the parameters added since 0.1 come back at their defaults, which keep
+    # 0.1's behaviour: get_params, set_params and clone work (GridSearchCV over
+    # a loaded model's decision parameters), and the labels are 0.1's
+    from sklearn.base import clone
+
+    model = _load_fixture(name, kind)
+    params = model.get_params(deep=False)
+    assert clone(model).get_params(deep=False).keys() == params.keys()
+    model.set_params(**params)
+    X, expected = stored
+    got = _outputs(model, X, {"predict"})["predict"]
+    for i, (a, b) in enumerate(zip(got, expected[name]["predict"])):
+        assert np.array_equal(a, b), f"{name}.{kind}: sequence {i}"
 
 
 def _schema(path):

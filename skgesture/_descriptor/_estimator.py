@@ -47,6 +47,7 @@ from skgesture.layouts import (
     DescriptorJoints,
     get_descriptor_joints,
 )
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
     check_skeletons,
     missing_frames,
@@ -58,7 +59,11 @@ __all__ = ["PoseDescriptor"]
 
 
 class PoseDescriptor(
-    StreamableMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+    NewParamsMixin,
+    StreamableMixin,
+    TransformerMixin,
+    BaseEstimator,
+    auto_wrap_output_keys=None,
 ):
     """Per-frame handcrafted pose descriptor of Brás, Simão & Neto.
 

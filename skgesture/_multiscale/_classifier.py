@@ -38,6 +38,7 @@ from skgesture._windows import (
     scale_matrix,
 )
 from skgesture.utils._fitting import fit_inner_estimator
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import labels_to_segments, runs
 from skgesture.utils._validation import (
     SequenceOf,
@@ -87,7 +88,9 @@ def _guess_step(W, D, t, k, j, mid, F):
     return ""
 
 
-class MultiScaleClassifier(StreamableMixin, ClassifierMixin, BaseEstimator):
+class MultiScaleClassifier(
+    NewParamsMixin, StreamableMixin, ClassifierMixin, BaseEstimator
+):
     """Dynamic-pose classifier at one or more time scales, with the paper's rules.
 
     Fits one clone of ``estimator`` per time scale on the windows of every

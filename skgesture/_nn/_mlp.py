@@ -14,12 +14,13 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from skgesture._nn._defaults import SCG_MAX_FAIL, TEST_FRACTION, VALIDATION_FRACTION
 from skgesture._nn._fast import ACTIVATIONS, MLPProba
 from skgesture.utils._fitting import seed_from
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import SequenceOf
 
 __all__ = ["TorchMLPClassifier", "fast_proba"]
 
 
-class TorchMLPClassifier(ClassifierMixin, BaseEstimator):
+class TorchMLPClassifier(NewParamsMixin, ClassifierMixin, BaseEstimator):
     """Multi-layer perceptron trained through skorch, MATLAB-style by default.
 
     An ordinary 2-D scikit-learn classifier (one row per sample). With two

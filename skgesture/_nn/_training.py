@@ -32,6 +32,7 @@ from skgesture._nn._defaults import (
     VALIDATION_FRACTION,
 )
 from skgesture._nn._modules import MLPModule
+from skgesture.utils._params import NewParamsMixin
 
 __all__ = [
     "FramewiseLoss",
@@ -437,7 +438,7 @@ def _silent(*args, **kwargs):
     """A skorch ``sink`` that prints nothing."""
 
 
-class FramewiseNetwork(BaseEstimator):
+class FramewiseNetwork(NewParamsMixin, BaseEstimator):
     """The trainable part of a tagger, with the training loop every tagger shares.
 
     A subclass is fitted through :func:`~skgesture.utils._fitting.fit_cached`

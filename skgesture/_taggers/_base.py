@@ -39,6 +39,7 @@ from skgesture._taggers._namer import namer_batch, namer_of, namer_scores
 from skgesture._taggers._stream import TrailingWindowStream
 from skgesture._taggers._viterbi import chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import runs
 from skgesture.utils._validation import (
     check_sequence_labels,
@@ -77,7 +78,7 @@ _STREAM_CONSTRAINTS = {
 }
 
 
-class _BaseTagger(StreamableMixin, ClassifierMixin, BaseEstimator):
+class _BaseTagger(NewParamsMixin, StreamableMixin, ClassifierMixin, BaseEstimator):
     """Per-frame classifier of whole sequences, with one decoding path.
 
     Subclasses implement ``_network(n_classes)`` (an unfitted estimator whose

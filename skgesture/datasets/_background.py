@@ -18,6 +18,7 @@ from sklearn.base import BaseEstimator
 from sklearn.utils import Bunch, check_random_state
 
 from skgesture.datasets._synthetic import _check_int, _check_real
+from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import labels_to_segments
 from skgesture.utils._validation import (
     check_sequence_labels,
@@ -519,7 +520,7 @@ recordings are left out.
 """
 
 
-class SyntheticBackground(BaseEstimator):
+class SyntheticBackground(NewParamsMixin, BaseEstimator):
     """Background sequences made in ``fit``, from the training recordings.
 
     The parameters of :func:`make_background`, as an object a
