@@ -37,7 +37,7 @@ from skgesture._taggers._decoding import (
 )
 from skgesture._taggers._namer import namer_batch, namer_of, namer_scores
 from skgesture._taggers._stream import TrailingWindowStream
-from skgesture._taggers._viterbi import chain_lengths
+from skgesture._taggers._viterbi import DECISIONS, chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
 from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import runs
@@ -69,7 +69,7 @@ _DECODING_CONSTRAINTS = {
     "viterbi_penalty": [None, Interval(Real, 0, None, closed="left")],
     "viterbi_duration": [Interval(Real, 0, None, closed="left")],
     "viterbi_lag": [Interval(Integral, 0, None, closed="left")],
-    "viterbi_decision": [StrOptions({"frame", "run"})],
+    "viterbi_decision": [StrOptions(set(DECISIONS))],
 }
 
 _STREAM_CONSTRAINTS = {

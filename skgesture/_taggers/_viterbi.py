@@ -121,26 +121,26 @@ def _forward(delta, lp, first, last, cls, pen, lag, whole, held, ring, t, out, o
         for back in range(lag):
             s = ring[(tau - back) % cap][s]
         v = cls[s]  # frame tau - lag on the best path of now
-        h = held[0]
-        if whole and h < 0 and v != 0:
-            held[0] = tau - lag  # a gesture begins: hold its frames
-            continue
-        if whole and h >= 0 and v != 0 and tau - h + 1 < cap:
-            continue  # the gesture goes on
-        if whole and h >= 0:  # decide the held frames from the path of now
-            stop = tau - lag + (0 if v == 0 else 1)
-            s = top
-            for x in range(tau, h, -1):
-                if x < stop:
-                    out[n + x - h] = cls[s]
-                s = ring[x % cap][s]
-            out[n] = cls[s]
-            for x in range(stop - h):
-                owner[n + x] = i
-            n += stop - h
-            held[0] = -1
-            if v != 0:
-                continue
+        if whole:
+            h = held[0]
+            if v != 0 and (h < 0 or tau - h + 1 < cap):
+                if h < 0:
+                    held[0] = tau - lag  # a gesture begins: hold its frames
+                continue  # (or it goes on)
+            if h >= 0:  # decide the held frames from the path of now
+                stop = tau - lag + (0 if v == 0 else 1)
+                s = top
+                for x in range(tau, h, -1):
+                    if x < stop:
+                        out[n + x - h] = cls[s]
+                    s = ring[x % cap][s]
+                out[n] = cls[s]
+                for x in range(stop - h):
+                    owner[n + x] = i
+                n += stop - h
+                held[0] = -1
+                if v != 0:  # MAX_HELD frames held: decided where it stands
+                    continue
         out[n] = v
         owner[n] = i
         n += 1
@@ -276,7 +276,8 @@ class ViterbiPath:
         arrival decided it (``lag`` rows later; with ``decision="run"``, a
         gesture's frames all by the row that ends it)."""
         lp = np.ascontiguousarray(lp, dtype=np.float64)
-        out = np.empty(len(lp) + len(self.ring), dtype=np.int64)
+        # at most every frame not yet decided: the held ones and these
+        out = np.empty(self.t - self.decided + len(lp), dtype=np.int64)
         owner = np.empty(len(out), dtype=np.int64)
         self.t, n = _kernels()[0](
             self.delta, lp, self.first, self.last, self.cls, self.penalty,
