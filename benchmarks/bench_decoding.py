@@ -205,7 +205,7 @@ GRID = {
     "min_duration": (0.0, 0.3, 0.5),
     "max_duration": (None, 1.5, 2.5),  # None: no limit
     "viterbi_penalty": (None, 2.0, 5.0, 10.0),  # None: the arg-max path
-    "max_novelty": (None, 1.75),  # None: no limit; VARY sweeps it
+    "max_novelty": (None, 1.5),  # None: no limit; VARY sweeps it
 }
 # --vary; viterbi_lag (frames between a frame and its decision, the live
 # delay's share of the decoding) stays the default in GRID
@@ -226,7 +226,7 @@ QUICK_GRID = {
     "min_duration": (0.0, 0.5),
     "max_duration": (None, 2.5),
     "viterbi_penalty": (None, 5.0),
-    "max_novelty": (None, 1.75),
+    "max_novelty": (None, 1.5),
 }
 TOLERANCE = 0.005  # the chosen setting loses at most this Jaccard anywhere
 PROBA_DTYPE = np.float32  # of the cache: the network's softmax is float32

@@ -118,7 +118,8 @@ BAD_PARAMS = {
                       "stream_warmup": -1},
     "SequenceTagger": {
         "architecture": "rnn", "hidden_sizes": 8, "dropout": 1.0, "tcn_layers": 0,
-        "tcn_stages": 0, "smoothing_weight": -1.0, "crop_length": 1,
+        "tcn_stages": 0, "smoothing_weight": -1.0, "smoothing_margin": -1,
+        "crop_length": 1,
         "batch_size": 0, "steps_per_epoch": 0, "max_epochs": 0,
         "learning_rate": 0.0, "weight_decay": -1.0, "clip_norm": 0.0,
         "class_weight": "inverse", "augment": "rotate", "standardize": "yes",

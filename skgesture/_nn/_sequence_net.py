@@ -264,6 +264,7 @@ class _CropNet(FramewiseNetwork):
         tcn_stages=2,
         lookahead=None,
         smoothing_weight=0.0,
+        smoothing_margin=0,
         crop_length=128,
         batch_size=32,
         steps_per_epoch=20,
@@ -290,6 +291,7 @@ class _CropNet(FramewiseNetwork):
         self.tcn_stages = tcn_stages
         self.lookahead = lookahead
         self.smoothing_weight = smoothing_weight
+        self.smoothing_margin = smoothing_margin
         self.crop_length = crop_length
         self.batch_size = batch_size
         self.steps_per_epoch = steps_per_epoch
@@ -367,6 +369,7 @@ class _CropNet(FramewiseNetwork):
             criterion_params={
                 "class_weight": self.class_weight,
                 "smoothing_weight": float(self.smoothing_weight),
+                "smoothing_margin": int(self.smoothing_margin),
             },
             optimizer=torch.optim.AdamW,
             optimizer__weight_decay=self.weight_decay,

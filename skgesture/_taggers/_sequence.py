@@ -90,6 +90,10 @@ class SequenceTagger(_BaseTagger):
         look-ahead behind (docs/streaming.md, "Exact streaming").
     smoothing_weight : float, default=0.0
         Weight of the MS-TCN smoothing loss (0.15 in Farha & Gall 2019).
+    smoothing_margin : int, default=0
+        Frames on each side of a true boundary of a training crop that the
+        smoothing loss leaves out, so that it smooths within gestures and rest
+        without holding back their onsets and ends; 0: every frame.
     crop_length : int, default=128
         Frames per training crop.
     batch_size : int, default=32
@@ -334,6 +338,7 @@ class SequenceTagger(_BaseTagger):
         "tcn_layers": [Interval(Integral, 1, None, closed="left")],
         "tcn_stages": [Interval(Integral, 1, None, closed="left")],
         "smoothing_weight": [Interval(Real, 0, None, closed="left")],
+        "smoothing_margin": [Interval(Integral, 0, None, closed="left")],
         "crop_length": [Interval(Integral, 2, None, closed="left")],
         "batch_size": [Interval(Integral, 1, None, closed="left")],
         "steps_per_epoch": [Interval(Integral, 1, None, closed="left")],
@@ -382,6 +387,7 @@ class SequenceTagger(_BaseTagger):
         tcn_stages=2,
         lookahead=None,
         smoothing_weight=0.0,
+        smoothing_margin=0,
         crop_length=128,
         batch_size=32,
         steps_per_epoch=20,
@@ -428,6 +434,7 @@ class SequenceTagger(_BaseTagger):
         self.tcn_stages = tcn_stages
         self.lookahead = lookahead
         self.smoothing_weight = smoothing_weight
+        self.smoothing_margin = smoothing_margin
         self.crop_length = crop_length
         self.batch_size = batch_size
         self.steps_per_epoch = steps_per_epoch
@@ -643,6 +650,7 @@ default=None
             tcn_stages=self.tcn_stages,
             lookahead=self.lookahead,
             smoothing_weight=self.smoothing_weight,
+            smoothing_margin=self.smoothing_margin,
             crop_length=self.crop_length,
             steps_per_epoch=self.steps_per_epoch,
             clip_norm=self.clip_norm,
