@@ -396,6 +396,11 @@ class FramewiseLoss(nn.Module):
 
     def forward(self, output, target):
         stages = output if isinstance(output, (tuple, list)) else (output,)
+        if self.smoothing_weight:
+            # the pairs of frames smoothed: the same for every stage
+            valid = (target[:, 1:] != IGNORE_INDEX) & (target[:, :-1] != IGNORE_INDEX)
+            if self.smoothing_margin:
+                valid = valid & ~near_boundary(target, self.smoothing_margin)
         loss = None
         for logits in stages:
             term = self._cross_entropy(logits, target)
@@ -403,18 +408,14 @@ class FramewiseLoss(nn.Module):
             if self.smoothing_weight:
                 logp = F.log_softmax(logits, dim=-1)
                 change = (logp[:, 1:] - logp[:, :-1].detach()) ** 2
-                valid = (target[:, 1:] != IGNORE_INDEX) & (
-                    target[:, :-1] != IGNORE_INDEX
-                )
-                if self.smoothing_margin:
-                    valid = valid & ~near_boundary(target, self.smoothing_margin)
                 if valid.any():
                     change = torch.clamp(change, max=SMOOTHING_CLAMP)[valid]
                     loss = loss + self.smoothing_weight * change.mean()
         return loss
 
     def __setstate__(self, state):
-        # criteria pickled before smoothing_margin existed smooth every pair
+        # criteria pickled before the smoothing loss (or its margin) existed
+        state.setdefault("smoothing_weight", 0.0)
         state.setdefault("smoothing_margin", 0)
         super().__setstate__(state)
 

@@ -170,7 +170,6 @@ class _StepCrossEntropy(FramewiseLoss):
     load."""
 
     def __setstate__(self, state):
-        state.setdefault("smoothing_weight", 0.0)
         super().__setstate__(state)
         self._buffers.setdefault("weight", None)
 
