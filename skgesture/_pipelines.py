@@ -26,7 +26,7 @@ __all__ = [
 
 # make_recommended's defaults (docs/choosing.md, docs/safety.md)
 LOOKAHEAD = 8  # frames of future the tagger reads
-SMOOTHING_MARGIN = 2  # frames each side of a true boundary the smoothing loss spares
+SMOOTHING_MARGIN = 4  # frames each side of a true boundary the smoothing loss spares
 MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short gesture
 MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
 VITERBI_PENALTY = 5.0  # the duration-aware path: nats to enter a gesture
@@ -242,7 +242,7 @@ def make_recommended(
     ``PoseDescriptor -> SequenceTagger(architecture="tcn", lookahead=8,
     namer="gru")``: the paper's pose descriptor of every frame, read by a
     three-stage dilated temporal convolutional network (32 channels, 8 layers a
-    stage, a smoothing loss that spares 2 frames each side of a true boundary,
+    stage, a smoothing loss that spares 4 frames each side of a true boundary,
     ``tagger__smoothing_margin``; Farha & Gall's MS-TCN) whose convolutions are
     causal and whose output for a frame is read 8 frames later, trained with
     AdamW and a warm-up cosine schedule on augmented 256-frame crops (time

@@ -568,7 +568,7 @@ def test_make_recommended_default_streams_exactly_on_the_descriptor():
     assert model.steps[-1][1].lookahead == 8
     assert model.steps[-1][1].viterbi_decision == "run"
     assert model.steps[-1][1].viterbi_lag == 4
-    assert model.steps[-1][1].smoothing_margin == 2  # onsets not smoothed away
+    assert model.steps[-1][1].smoothing_margin == 4  # onsets not smoothed away
     assert model.steps[-1][1].max_novelty == 1.5
     assert make_recommended(lookahead=None).steps[0][1].fill == "linear"
     offline = make_recommended(features="joints", lookahead=None)
