@@ -290,6 +290,14 @@ def test_smoothing_margin_spares_the_true_boundaries_alone():
         FramewiseLoss(smoothing_weight=0.15, smoothing_margin=2)(logits, flat),
         FramewiseLoss(smoothing_weight=0.15)(logits, flat),
     )
+    # a crop of one frame has no pair to smooth: the loss is the cross-entropy
+    one = torch.tensor([[1]])
+    logits = torch.randn(1, 1, 2)
+    assert near_boundary(one, 4).shape == (1, 0)
+    assert torch.equal(
+        FramewiseLoss(smoothing_weight=0.15, smoothing_margin=4)(logits, one),
+        FramewiseLoss()(logits, one),
+    )
 
 
 def test_a_tcn_trained_with_a_smoothing_margin_learns_a_toy_stream():

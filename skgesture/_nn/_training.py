@@ -445,7 +445,7 @@ def near_boundary(target, margin):
     frames, ``IGNORE_INDEX``, are no change)."""
     a, b = target[:, :-1], target[:, 1:]
     change = (a != b) & (a != IGNORE_INDEX) & (b != IGNORE_INDEX)
-    if margin <= 0:
+    if margin <= 0 or change.shape[1] == 0:  # a crop of one frame has no pair
         return change
     near = F.max_pool1d(
         change[:, None].float(), kernel_size=2 * margin + 1, stride=1, padding=margin
