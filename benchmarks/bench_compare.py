@@ -146,6 +146,7 @@ VARIANTS = {
         "lookahead": None,
     },
     "recommended (joints exact 8)": {"features": "joints", "lookahead": 8},
+    "recommended (descriptor+joints)": {"features": "descriptor+joints"},
 }
 
 

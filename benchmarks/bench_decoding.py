@@ -228,6 +228,8 @@ QUICK_GRID = {
     "viterbi_penalty": (None, 5.0),
     "max_novelty": (None, 1.5),
 }
+# --set names that are make_recommended's arguments, not set_params ones
+FACTORY_PARAMS = ("features", "lookahead", "background_for")
 TOLERANCE = 0.005  # the chosen setting loses at most this Jaccard anywhere
 PROBA_DTYPE = np.float32  # of the cache: the network's softmax is float32
 
@@ -347,11 +349,17 @@ def build_model(joints, seed, quick, background=None, fit_threads=None, params=N
     ``bench_oov.make_model``'s tiny tagger, 20 joints) with the background
     variant ``background`` (``background_of``; None: the model's own);
     ``fit_threads`` (None: the model's) sets the tagger's; ``params`` (a
-    dict or None) are set last (``set_params``)."""
+    dict or None) are set last (``set_params``), but for those of
+    ``FACTORY_PARAMS``, which are ``make_recommended``'s arguments."""
+    params = dict(params or {})
+    # make_recommended's own arguments (--set features=descriptor+joints)
+    factory = {k: params.pop(k) for k in FACTORY_PARAMS if k in params}
     if quick:
+        if factory:
+            raise ValueError(f"quick mode builds no make_recommended: {factory}")
         model = make_model(seed, quick=True)
     else:
-        model = skgesture.make_recommended(joints=joints, random_state=seed)
+        model = skgesture.make_recommended(joints=joints, random_state=seed, **factory)
     if background is not None:
         model.set_params(
             background=background_of(background, seed),
@@ -1117,7 +1125,8 @@ def main(argv=None):
         nargs="+",
         default=[],
         metavar="PARAM=VALUE",
-        help="set_params of every model before its fit (cells of their own)",
+        help="set_params of every model before its fit (cells of their own); "
+        "features, lookahead and background_for go to make_recommended",
     )
     parser.add_argument(
         "--jobs", type=int, default=1, help="fits at once (worker processes)"

@@ -1,11 +1,13 @@
-"""Speed of the PoseDescriptor and of the synthetic stream generator (issues 2, 10).
+"""Speed of the per-frame features and of the synthetic stream generator (issues 2, 10).
 
 ``PoseDescriptor.transform`` on one core, with the compiled kernel (numba,
 when installed) and with the numpy implementation, as frames per second of
 wall time and of process CPU time (the better figure on a shared machine: wall
 time there includes the time other jobs hold the core). Median of 5 calls
 after one warm-up (which also compiles the kernel, or loads it from numba's
-cache). Issue 10's target: >= 1,000,000 frames/s for the 183-D descriptor.
+cache). ``JointFeatures.transform`` too, with the statistics of the whole
+sequence and with running ones (every row as the live step makes it).
+Issue 10's target: >= 1,000,000 frames/s for the 183-D descriptor.
 """
 
 import statistics
@@ -15,7 +17,7 @@ import numpy as np
 from _common import one_core
 
 import skgesture._descriptor._compute as descriptor_module
-from skgesture import PoseDescriptor
+from skgesture import JointFeatures, PoseDescriptor
 from skgesture._stream import stream_frames
 from skgesture.datasets import make_gesture_streams
 
@@ -104,6 +106,15 @@ def run(quick=False):
                 wall, cpu = _median(lambda: _push_each(hold, live), repeat=3)
                 what = "  live step, one frame per push (paper11)"
                 rows.append(_row(what, path, len(live), wall, cpu))
+            # The recommended model's other features; "running": offline as
+            # live, every row with the statistics of its own trailing window.
+            for joints in ("paper11", "full20"):
+                for stats in ("sequence", "running"):
+                    feats = JointFeatures(joints=joints, fill="hold", statistics=stats)
+                    feats.fit(data.X)
+                    wall, cpu = _median(lambda: feats.transform(data.X))
+                    what = f"JointFeatures ({joints}, {stats} statistics)"
+                    rows.append(_row(what, "numpy", n_frames, wall, cpu))
             n_gen = 200 if quick else 1000
             wall, cpu = _median(
                 lambda: make_gesture_streams(n_gen, random_state=1), repeat=3, warmup=0

@@ -25,6 +25,7 @@ _LAZY = {
     "BiLSTMTagger": "skgesture._taggers._bilstm",
     "TorchMLPClassifier": "skgesture._nn._mlp",
     "JointFeatures": "skgesture._features",
+    "ConcatFeatures": "skgesture._concat",
     "SkeletonAugmenter": "skgesture._augment",
     "SequenceTagger": "skgesture._taggers._sequence",
     "VotingTagger": "skgesture._taggers._voting",

@@ -27,10 +27,11 @@ from skgesture.utils._buffers import (
 )
 from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
+    SequenceOutputMixin,
     check_skeletons,
     check_stream_frames,
+    mask_rows,
     missing_frames,
-    refuse_set_output,
     sequence_tags,
 )
 
@@ -171,7 +172,14 @@ def _with_derivatives(flat, velocities, accelerations):
     return np.hstack(parts).astype(np.float32)
 
 
-class JointFeatures(NewParamsMixin, StreamableMixin, TransformerMixin, BaseEstimator):
+class JointFeatures(
+    NewParamsMixin,
+    StreamableMixin,
+    SequenceOutputMixin,
+    TransformerMixin,
+    BaseEstimator,
+    auto_wrap_output_keys=None,
+):
     """Body-normalised joint positions and velocities of every frame.
 
     Per sequence: untracked frames are filled (as :class:`PoseDescriptor`
@@ -349,12 +357,7 @@ class JointFeatures(NewParamsMixin, StreamableMixin, TransformerMixin, BaseEstim
                 align=self.align,
                 fill=self.fill,
             )
-            rows = missing_frames(seq)
-            if rows.any():
-                feats = np.ma.MaskedArray(
-                    feats, mask=np.repeat(rows[:, None], feats.shape[1], axis=1)
-                )
-            out.append(feats)
+            out.append(mask_rows(feats, missing_frames(seq)))
         return out
 
     def _running(self, seq, index):
@@ -364,27 +367,7 @@ class JointFeatures(NewParamsMixin, StreamableMixin, TransformerMixin, BaseEstim
         state = JointFeatureStream(self, index)
         parts = [state.step(stream_frames(seq, 0)), state.flush()]
         data = np.concatenate([p.data for p in parts]).astype(np.float32, copy=False)
-        mask = np.concatenate([p.mask for p in parts])
-        if mask.any():
-            return np.ma.MaskedArray(
-                data, mask=np.repeat(mask[:, None], data.shape[1], axis=1)
-            )
-        return data
-
-    def set_output(self, *, transform=None):
-        """Refuse a DataFrame output: a list of sequences has none.
-
-        Parameters
-        ----------
-        transform : {"default"} or None, default=None
-            Only ``"default"`` and ``None`` (no change) are accepted.
-
-        Returns
-        -------
-        self : JointFeatures
-            Unchanged.
-        """
-        return refuse_set_output(self, transform)
+        return mask_rows(data, np.concatenate([p.mask for p in parts]))
 
     def get_feature_names_out(self, input_features=None):
         """Get the names of the features, e.g. ``"pos_HandRight_x"``, ``"vel_Head_y"``.
@@ -505,6 +488,8 @@ class JointFeatureStream:
         self.normalised = _normalised
         self.derivatives = _with_derivatives
         self.index = index
+        self.root = KINECT_V1.index(ROOT)
+        self.root_column = int(np.flatnonzero(np.asarray(index) == self.root)[0])
         self.velocities = bool(feats.velocities)
         self.accelerations = bool(feats.accelerations)
         self.align = bool(feats.align)
@@ -562,9 +547,52 @@ class JointFeatureStream:
         shared = min(start - self.a + 1, now - self.a + 1)
         if shared > self.n_out:
             parts.append(self._emit(self.n_out, shared, start))
-        for t in range(self.n_out, now - self.a + 1):
-            parts.append(self._emit(t, t + 1, t + self.a))
+        parts.append(self._emit_each(self.n_out, now - self.a + 1))
         return _concat_rows(parts, (self.width,), np.float32)
+
+    def _emit_each(self, lo, hi):
+        """Rows ``lo .. hi - 1``, row ``t`` with the statistics at frame ``t + a``.
+
+        Velocities alone (``a`` = 1) without ``align``: the rows whose three
+        frames are all filled are computed at once (:meth:`_emit_batch`), with
+        the arithmetic of :meth:`_emit`, value for value; the others one by one.
+        """
+        a = self.a
+        batch = a == 1 and self.velocities and not self.align
+        first = min(hi, max(lo, self.p0 + a)) if batch else hi
+        parts = [self._emit(t, t + 1, t + a) for t in range(lo, first)]
+        if first < hi:
+            parts.append(self._emit_batch(first, hi))
+        return _concat_rows(parts, (self.width,), np.float32)
+
+    def _emit_batch(self, lo, hi):
+        """Rows ``lo .. hi - 1`` (``a`` = 1, no ``align``), each with the
+        statistics at its next frame: :meth:`_emit` on every row's three
+        frames (``_normalised``, then ``numpy.gradient``'s central difference),
+        vectorised over the rows."""
+        n = hi - lo
+        stats = [self._stats(t + 1) for t in range(lo, hi)]
+        scale = np.array([s[0] for s in stats], dtype=np.float64)[:, None, None]
+        hip_median = np.array([s[1] for s in stats], dtype=np.float64)
+        q = self.R.data(lo - 1, hi + 1)  # frames lo - 1 .. hi
+        hip = q[:, self.root].copy()
+        rel = (q - hip[:, None, :])[:, self.index]
+
+        def normalised(d):  # frames t + d, with the statistics of row t
+            p = rel[1 + d : 1 + d + n].copy()
+            p[:, self.root_column] = hip[1 + d : 1 + d + n] - hip_median
+            return (p / scale).reshape(n, -1)
+
+        before, flat, after = normalised(-1), normalised(0), normalised(1)
+        data = np.hstack([flat, (after - before) / 2.0]).astype(np.float32)
+        rows = Rows(
+            data,
+            self.untracked.data(lo, hi).copy(),
+            self.times.data(lo + 1, hi + 1).copy(),
+        )
+        self.n_out = hi
+        self._trim()
+        return rows
 
     def _stats(self, tau):
         """Statistics of the last ``window`` tracked frames up to frame ``tau``."""

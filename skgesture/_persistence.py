@@ -628,6 +628,12 @@ def _input_layout(estimator):
     while isinstance(first, Pipeline) and first.steps:
         first = first.steps[0][1]
     shape = getattr(first, "frame_shape_in_", None)
+    from skgesture._concat import ConcatFeatures
+
+    if isinstance(first, ConcatFeatures) and first.transformers:
+        # features side by side read the same raw skeletons: the first's
+        # layout and joints are the model's
+        first = getattr(first, "transformers_", first.transformers)[0][1]
     fps = getattr(estimator, "fps_", None)  # a GesturePipeline's training rate
     info = {
         "frame_shape": None if shape is None else [int(s) for s in shape],

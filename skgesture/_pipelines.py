@@ -3,6 +3,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 from skgesture._augment import SkeletonAugmenter
+from skgesture._concat import ConcatFeatures
 from skgesture._descriptor._estimator import PoseDescriptor
 from skgesture._features import JointFeatures
 from skgesture._gesture_pipeline import GesturePipeline
@@ -26,6 +27,7 @@ __all__ = [
 
 # make_recommended's defaults (docs/choosing.md, docs/safety.md)
 LOOKAHEAD = 8  # frames of future the tagger reads
+FEATURES = ("descriptor", "joints", "descriptor+joints")  # make_recommended's
 SMOOTHING_MARGIN = 4  # frames each side of a true boundary the smoothing loss spares
 MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short gesture
 MAX_DURATION = 2.5  # or longer than this multiple of its long gesture are rest
@@ -264,7 +266,8 @@ def make_recommended(
     joints : {"paper11", "full20"} or sequence of str, default="paper11"
         Joints of the features: the paper's 11 upper-body joints or all 20
         (better whenever the legs move, e.g. kicks).
-    features : {"descriptor", "joints"}, default="descriptor"
+    features : {"descriptor", "joints", "descriptor+joints"}, \
+default="descriptor"
         ``"descriptor"``: the paper's :class:`PoseDescriptor` (angles and
         distance ratios), with time warp and noise as the only augmentations.
         ``"joints"``: :class:`JointFeatures`, joint positions relative to the
@@ -272,6 +275,9 @@ def make_recommended(
         rotation about the vertical axis and a scale; with
         ``lookahead=None`` the best offline model on PRECOG, and worse than
         the descriptor on separated gestures and when streamed.
+        ``"descriptor+joints"``: both side by side (:class:`ConcatFeatures`,
+        183 + 66 values a frame for the paper's 11 joints), augmented as the
+        descriptor; docs/choosing.md gives its scores.
     lookahead : int or None, default=8
         An int ``L``: the model that streams exactly. The TCN's convolutions
         are causal, its output for a frame read ``L`` frames later
@@ -367,8 +373,11 @@ default="synthetic"
     >>> type(offline.named_steps["features"]).__name__
     'JointFeatures'
     """
-    if features not in ("joints", "descriptor"):
-        raise ValueError(f"features must be 'joints' or 'descriptor', got {features!r}")
+    if features not in FEATURES:
+        raise ValueError(
+            f"features must be one of {', '.join(map(repr, FEATURES))}, got "
+            f"{features!r}"
+        )
     live = {} if lookahead is None else {"statistics": "running", "fill": "hold"}
     if features == "joints":
         step = JointFeatures(joints=joints, **live)
@@ -377,11 +386,16 @@ default="synthetic"
         )
     else:
         # The descriptor is built from angles and distances: rotating or
-        # scaling its 183/426 values as coordinates would be meaningless.
+        # scaling its 183/426 values as coordinates would be meaningless (and
+        # beside it, a rotated joints' block would disagree with it).
         # Live, an untracked frame is the last tracked one (the future is
         # unknown): offline does the same, so that the stream is exact.
         step = PoseDescriptor(joints=joints, fill=live.get("fill", "linear"))
         augment = SkeletonAugmenter(rotation=0.0, scale=0.0, time_warp=0.2, noise=0.02)
+        if features == "descriptor+joints":
+            step = ConcatFeatures(
+                [("descriptor", step), ("joints", JointFeatures(joints=joints, **live))]
+            )
     tagger = SequenceTagger(
         architecture="tcn",
         hidden_sizes=(32,),

@@ -18,9 +18,9 @@ from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import remove_short_runs, runs
 from skgesture.utils._smoothing import LoessStepper, loess_smooth
 from skgesture.utils._validation import (
+    SequenceOutputMixin,
     check_sequence_labels,
     check_sequences,
-    refuse_set_output,
     sequence_tags,
     untracked_rows,
 )
@@ -88,6 +88,7 @@ class ActivitySegmenter(
     NewParamsMixin,
     StreamableMixin,
     ClassifierMixin,
+    SequenceOutputMixin,
     TransformerMixin,
     BaseEstimator,
     auto_wrap_output_keys=None,
@@ -386,21 +387,6 @@ class ActivitySegmenter(
         """
         check_is_fitted(self)
         return _check_feature_names_in(self, input_features)
-
-    def set_output(self, *, transform=None):
-        """Refuse a DataFrame output: a list of masked arrays has none.
-
-        Parameters
-        ----------
-        transform : {"default"} or None, default=None
-            Only ``"default"`` and ``None`` (no change) are accepted.
-
-        Returns
-        -------
-        self : ActivitySegmenter
-            Unchanged.
-        """
-        return refuse_set_output(self, transform)
 
     def _smooth(self, score):
         return np.asarray(loess_smooth(score, self.smooth_span))

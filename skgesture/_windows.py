@@ -13,8 +13,8 @@ from skgesture._stream import Rows, StreamableMixin
 from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
     SequenceOf,
+    SequenceOutputMixin,
     check_sequences,
-    refuse_set_output,
     sequence_tags,
     untracked_rows,
 )
@@ -316,6 +316,7 @@ def check_lazy_windows(X, steps, n_poses, estimator, reset):
 class DynamicPoseWindow(
     NewParamsMixin,
     StreamableMixin,
+    SequenceOutputMixin,
     TransformerMixin,
     BaseEstimator,
     auto_wrap_output_keys=None,
@@ -489,21 +490,6 @@ class DynamicPoseWindow(
             for name in names
         ]
         return np.asarray(out, dtype=object)
-
-    def set_output(self, *, transform=None):
-        """Refuse a DataFrame output: a list of 3-D window arrays has none.
-
-        Parameters
-        ----------
-        transform : {"default"} or None, default=None
-            Only ``"default"`` and ``None`` (no change) are accepted.
-
-        Returns
-        -------
-        self : DynamicPoseWindow
-            Unchanged.
-        """
-        return refuse_set_output(self, transform)
 
     def __sklearn_tags__(self):
         return sequence_tags(super().__sklearn_tags__())

@@ -399,3 +399,15 @@ def test_set_fits_every_model_with_its_params_in_cells_of_their_own(tmp_path):
     }
     with pytest.raises(SystemExit, match="PARAM=VALUE"):
         bench_decoding.parse_params(["lookahead"])
+
+
+def test_set_passes_make_recommended_arguments_to_the_factory():
+    """``--set features=descriptor+joints``: the features are make_recommended's
+    argument (no set_params has them); the other names are set_params ones."""
+    params = {"features": "descriptor+joints", "tagger__dropout": 0.05}
+    model = bench_decoding.build_model("paper11", 0, False, params=params)
+    assert type(model.named_steps["features"]).__name__ == "ConcatFeatures"
+    assert model.named_steps["tagger"].dropout == 0.05
+    assert params == {"features": "descriptor+joints", "tagger__dropout": 0.05}
+    with pytest.raises(ValueError, match="quick mode"):
+        bench_decoding.build_model("full20", 0, True, params={"features": "joints"})

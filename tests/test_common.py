@@ -27,6 +27,8 @@ from sklearn.utils.validation import check_is_fitted
 import skgesture
 from skgesture import (
     DynamicPoseWindow,
+    JointFeatures,
+    PoseDescriptor,
     SequenceTagger,
     SkeletonAugmenter,
     TorchMLPClassifier,
@@ -69,6 +71,8 @@ INIT_PARAMS = {
                              "random_state": 0},
     "BiLSTMTagger": {"hidden_sizes": (4,), "max_epochs": 2, "random_state": 0},
     "JointFeatures": {},
+    "ConcatFeatures": {"transformers": [("desc", PoseDescriptor()),
+                                        ("joints", JointFeatures())]},
     "SkeletonAugmenter": {},
     "SequenceTagger": {**FAST_TAGGER, "random_state": 0},
     "VotingTagger": {"estimators": [("a", SequenceTagger(**FAST_TAGGER)),
@@ -168,6 +172,7 @@ OTHER_PARAMS = {
                       "accelerations": True, "align": True, "fill": "hold",
                       "statistics": "running", "stream_stats_window": 100,
                       "stream_warmup": 5},
+    "ConcatFeatures": {"transformers": [("j", JointFeatures(velocities=False))]},
     "SkeletonAugmenter": {"rotation": 5.0, "scale": 0.0, "time_warp": 0.5,
                           "noise": 0.1},
     "SequenceTagger": {"architecture": "tcn", "hidden_sizes": [16],
@@ -211,8 +216,11 @@ def _make(name, **params):
     params = {
         k: clone(v) if isinstance(v, BaseEstimator) else v for k, v in params.items()
     }
-    if name == "GesturePipeline":  # fresh steps too
-        params["steps"] = [(n, clone(est)) for n, est in params["steps"]]
+    # fresh inner steps too
+    nested = {"GesturePipeline": "steps", "ConcatFeatures": "transformers"}
+    if name in nested:
+        key = nested[name]
+        params[key] = [(n, clone(est)) for n, est in params[key]]
     return ESTIMATORS[name](**params)
 
 
@@ -262,6 +270,7 @@ OTHER_DATA = {
     "MultiScaleClassifier": lambda X, y: (X[:2], y[:2]),
     "BiLSTMTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
     "JointFeatures": lambda X, y: ([x[::-1] * 1.5 for x in X], None),
+    "ConcatFeatures": lambda X, y: ([x[::-1] * 1.5 for x in X], None),
     "SequenceTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
     "VotingTagger": lambda X, y: ([X[0][:60]], [y[0][:60]]),
     "GesturePipeline": lambda X, y: (X[1:], y[1:]),
@@ -275,6 +284,7 @@ DATA = {
     "MultiScaleClassifier": lambda: (*_windows(), "predict_segments"),
     "BiLSTMTagger": lambda: (*_features(), "predict_proba"),
     "JointFeatures": lambda: (_skeletons(), None, "transform"),
+    "ConcatFeatures": lambda: (_skeletons(), None, "transform"),
     "SequenceTagger": lambda: (*_features(), "predict_proba"),
     "VotingTagger": lambda: (*_features(), "predict_proba"),
     "GesturePipeline": lambda: (*_streams(), "predict_segments"),

@@ -104,6 +104,36 @@ def test_running_statistics_give_the_live_rows_offline():
     assert not np.allclose(np.ma.getdata(whole), live)
 
 
+def test_running_rows_are_those_of_their_own_trailing_statistics():
+    # each row: its three frames normalised with the statistics (medians) of
+    # the tracked frames up to the next one, then numpy.gradient (the rows
+    # are computed many at once offline; this is the definition, row by row)
+    from skgesture._features import (
+        _frame_quantities,
+        _normalised,
+        _statistics,
+        _with_derivatives,
+    )
+
+    X, _ = make_skeleton_stream(random_state=1)
+    feats = JointFeatures(statistics="running", fill="hold").fit([X])
+    got = np.ma.getdata(feats.transform([X])[0])
+    index = feats._joint_index
+    for t in (1, 2, 30, len(X) - 2):
+        stats = _statistics(_frame_quantities(X[: t + 2]), False)
+        want = _with_derivatives(
+            _normalised(X[t - 1 : t + 2], index, stats), True, False
+        )
+        assert_array_equal(got[t], want[1])
+    with_window = JointFeatures(
+        statistics="running", fill="hold", stream_stats_window=20
+    ).fit([X])
+    t = 100
+    stats = _statistics(_frame_quantities(X[t + 2 - 20 : t + 2]), False)
+    want = _with_derivatives(_normalised(X[t - 1 : t + 2], index, stats), True, False)
+    assert_array_equal(np.ma.getdata(with_window.transform([X])[0])[t], want[1])
+
+
 def test_running_statistics_need_the_live_fill():
     X, _ = make_skeleton_stream(random_state=0)
     with pytest.raises(ValueError, match="fill='hold'"):
@@ -294,7 +324,7 @@ def test_tcn_computes_the_convolutions_of_its_parameters(lookahead):
         assert_allclose(a.numpy(), p.grad.numpy(), rtol=1e-4, atol=1e-5)
 
 
-@pytest.mark.parametrize("features", ["descriptor", "joints"])
+@pytest.mark.parametrize("features", ["descriptor", "joints", "descriptor+joints"])
 def test_make_recommended_with_a_lookahead_streams_exactly(features):
     from skgesture import make_recommended
 
@@ -306,6 +336,8 @@ def test_make_recommended_with_a_lookahead_streams_exactly(features):
     )
     if features == "joints":
         assert model.named_steps["features"].statistics == "running"
+    if features == "descriptor+joints":
+        assert model.get_params()["features__joints__statistics"] == "running"
     # trained enough to find the gestures it is compared on
     model.set_params(
         tagger__hidden_sizes=(16,), tagger__tcn_layers=4, tagger__tcn_stages=2,
@@ -313,7 +345,9 @@ def test_make_recommended_with_a_lookahead_streams_exactly(features):
         tagger__learning_rate=1e-2, tagger__namer_hidden_sizes=(16,),
     )  # fmt: skip
     # live, an untracked frame is the last tracked one: offline too
-    assert model.named_steps["features"].fill == "hold"
+    stages = model.named_steps["features"]
+    stages = [t for _, t in getattr(stages, "transformers", [(None, stages)])]
+    assert [t.fill for t in stages] == ["hold"] * len(stages)
     with torch.random.fork_rng(devices=[]):
         model.fit(data.X[:4], data.y[:4])
     x = data.X[4].copy()

@@ -142,10 +142,11 @@ def test_round_trip_gives_identical_predictions(method, fitted, data, tmp_path):
         assert len(loaded_last.net_.history) == len(last.net_.history) == 2
 
 
-def test_round_trip_recommended(data, tmp_path):
+@pytest.mark.parametrize("features", ["descriptor", "descriptor+joints"])
+def test_round_trip_recommended(data, tmp_path, features):
     if not hasattr(skgesture, "make_recommended"):
         pytest.skip("skgesture.make_recommended does not exist yet (lead's tagger)")
-    pipe = skgesture.make_recommended(random_state=0)
+    pipe = skgesture.make_recommended(features=features, random_state=0)
     tagger = pipe.steps[-1][1]
     tiny = {
         k: v
@@ -160,7 +161,9 @@ def test_round_trip_recommended(data, tmp_path):
     _assert_same_predictions(pipe, loaded, data.X)
     # The manifest says what the model reads (it said null before).
     assert model_info(path)["input"]["layout"] == "kinect_v1"
-    assert model_info(path)["input"]["joints"] == pipe[0].joints
+    joints = pipe.get_params()["features__descriptor__joints" if "+" in features
+                               else "features__joints"]  # fmt: skip
+    assert model_info(path)["input"]["joints"] == joints
     with pytest.raises(ValueError, match="unknown layout"):
         load_model(path, layout="kinect2")
 

@@ -613,6 +613,13 @@ def test_make_recommended_descriptor_variant_reads_the_paper_descriptor():
     assert (augment.rotation, augment.scale) == (0.0, 0.0)
     with pytest.raises(ValueError, match="features must be"):
         make_recommended(features="pixels")
+    # both side by side: the descriptor then the running joint features
+    both = make_recommended(joints="paper11", features="descriptor+joints")
+    F = both.steps[0][1].fit([X]).transform([X])[0]
+    assert F.shape == (len(X), 183 + 66)
+    assert both.get_params()["features__joints__statistics"] == "running"
+    augment = both.steps[-1][1].augment
+    assert (augment.rotation, augment.scale) == (0.0, 0.0)
 
 
 def test_make_recommended_in_grid_search_with_groups(tmp_path):

@@ -49,9 +49,10 @@ from skgesture.layouts import (
 )
 from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._validation import (
+    SequenceOutputMixin,
     check_skeletons,
+    mask_rows,
     missing_frames,
-    refuse_set_output,
     sequence_tags,
 )
 
@@ -61,6 +62,7 @@ __all__ = ["PoseDescriptor"]
 class PoseDescriptor(
     NewParamsMixin,
     StreamableMixin,
+    SequenceOutputMixin,
     TransformerMixin,
     BaseEstimator,
     auto_wrap_output_keys=None,
@@ -279,34 +281,7 @@ class PoseDescriptor(
         self._check_joints(spec)
         X = check_skeletons(X, estimator=self, reset=False)
         out = self._describe_all(X, spec, standardize=True)
-        for i, seq in enumerate(X):
-            rows = missing_frames(seq)
-            if rows.any():
-                mask = np.repeat(rows[:, None], out[i].shape[1], axis=1)
-                out[i] = np.ma.MaskedArray(out[i], mask=mask)
-        return out
-
-    def set_output(self, *, transform=None):
-        """Refuse a DataFrame output: a list of sequences has none.
-
-        Parameters
-        ----------
-        transform : {"default"} or None, default=None
-            Only ``"default"`` and ``None`` (no change) are accepted.
-
-        Returns
-        -------
-        self : PoseDescriptor
-            Unchanged.
-
-        Raises
-        ------
-        ValueError
-            For ``"pandas"``, ``"polars"`` or any other container. Wrap one
-            sequence's descriptor yourself, e.g.
-            ``pandas.DataFrame(Z[i], columns=desc.get_feature_names_out())``.
-        """
-        return refuse_set_output(self, transform)
+        return [mask_rows(out[i], missing_frames(seq)) for i, seq in enumerate(X)]
 
     def get_feature_names_out(self, input_features=None):
         """Names of the descriptor features, in layout order.

@@ -333,6 +333,19 @@ def missing_frames(seq):
     return np.isnan(flat).any(axis=1) | ~np.any(flat != 0, axis=1)
 
 
+def mask_rows(data, rows):
+    """``data`` (2-D, one row per frame) with the rows ``rows`` masked.
+
+    The offline form of rest rows (data contract 2): a ``numpy.ma.MaskedArray``
+    whose mask covers every value of each masked row, or ``data`` itself when
+    no row is masked.
+    """
+    rows = np.asarray(rows, dtype=bool)
+    if not rows.any():
+        return data
+    return np.ma.MaskedArray(data, mask=np.repeat(rows[:, None], data.shape[1], axis=1))
+
+
 def untracked_rows(x):
     """Boolean mask of the untracked frames of one sequence, raw or described.
 
@@ -446,6 +459,29 @@ class SequenceOf(Options):
 
     def __str__(self):
         return self.description
+
+
+class SequenceOutputMixin:
+    """``set_output`` of a sequence stage, which returns lists of sequences.
+
+    Put before ``TransformerMixin`` in the bases: the one ``set_output`` of
+    every stage (:func:`refuse_set_output`).
+    """
+
+    def set_output(self, *, transform=None):
+        """Refuse a DataFrame output: a list of sequences has none.
+
+        Parameters
+        ----------
+        transform : {"default"} or None, default=None
+            Only ``"default"`` and ``None`` (no change) are accepted.
+
+        Returns
+        -------
+        self : object
+            This estimator, unchanged.
+        """
+        return refuse_set_output(self, transform)
 
 
 def refuse_set_output(estimator, transform):
