@@ -15,7 +15,7 @@ from sklearn.base import TransformerMixin, _fit_context, clone
 from sklearn.utils.metaestimators import _BaseComposition
 from sklearn.utils.validation import check_is_fitted
 
-from skgesture._stream import Rows, StreamableMixin
+from skgesture._stream import Rows, StreamableMixin, missing_stream_methods
 from skgesture.utils._buffers import _concat_rows
 from skgesture.utils._validation import (
     SequenceOutputMixin,
@@ -26,8 +26,6 @@ from skgesture.utils._validation import (
 )
 
 __all__ = ["ConcatFeatures"]
-
-_PROTOCOL = ("stream_init", "stream_step", "stream_flush", "stream_lookahead")
 
 
 class ConcatFeatures(
@@ -256,7 +254,7 @@ class ConcatFeatures(
         check_is_fitted(self)
         states = []
         for name, t in self.transformers_:
-            missing = [m for m in _PROTOCOL if not hasattr(t, m)]
+            missing = missing_stream_methods(t)
             if missing:
                 raise TypeError(
                     f"transformer {name!r} ({type(t).__name__}) cannot stream: it "

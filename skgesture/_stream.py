@@ -50,10 +50,18 @@ __all__ = [
     "Rows",
     "StreamSegment",
     "stream_frames",
+    "missing_stream_methods",
 ]
 
 DEFAULT_MAX_BACKFILL = 64  # leading untracked frames that may become copies
 DEFAULT_MAX_PERIOD = 1200  # frames (60 s at 20 fps) before a period is closed
+PROTOCOL = ("stream_init", "stream_step", "stream_flush", "stream_lookahead")
+
+
+def missing_stream_methods(stage):
+    """The names of :data:`PROTOCOL` that ``stage``'s class lacks (empty: it
+    can run on a stream). Read on the class, so that no property runs."""
+    return [name for name in PROTOCOL if not hasattr(type(stage), name)]
 
 
 class Rows:

@@ -21,7 +21,12 @@ from numbers import Integral
 import numpy as np
 
 from skgesture._rate import FrameResampler, check_fps, same_rate
-from skgesture._stream import DEFAULT_MAX_BACKFILL, DEFAULT_MAX_PERIOD, stream_frames
+from skgesture._stream import (
+    DEFAULT_MAX_BACKFILL,
+    DEFAULT_MAX_PERIOD,
+    missing_stream_methods,
+    stream_frames,
+)
 from skgesture.utils._buffers import _concat_rows
 
 __all__ = ["GestureEvent", "StreamingRecognizer"]
@@ -32,7 +37,6 @@ MAX_BATCH = 1024  # frames handed to the stages in one step by push_many
 # be complete) and the rounding of the map back to input frames
 # (skgesture._rate), ratio being input frames per model-rate frame.
 RESAMPLE_DELAY = 2
-_PROTOCOL = ("stream_init", "stream_step", "stream_flush", "stream_lookahead")
 
 
 @dataclass(frozen=True)
@@ -428,7 +432,7 @@ class StreamingRecognizer:
             )
         stages = [(n, est) for n, est in steps if est not in (None, "passthrough")]
         for name, est in stages:
-            missing = [m for m in _PROTOCOL if not hasattr(type(est), m)]
+            missing = missing_stream_methods(est)
             if missing:
                 raise TypeError(
                     f"step {name!r} ({type(est).__name__}) cannot run on a stream: "

@@ -480,6 +480,13 @@ class SequenceOutputMixin:
         -------
         self : object
             This estimator, unchanged.
+
+        Raises
+        ------
+        ValueError
+            For ``"pandas"``, ``"polars"`` or any other container. Wrap one
+            sequence's features yourself, e.g.
+            ``pandas.DataFrame(Xt[i], columns=stage.get_feature_names_out())``.
         """
         return refuse_set_output(self, transform)
 
