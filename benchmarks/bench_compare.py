@@ -126,11 +126,13 @@ def _skgesture_method(name):
     return Method(make=make, family="skgesture", sources=_skg_sources())
 
 
-def _variant(**params):
-    """A ``make`` of ``make_recommended(**params)``: the candidates of the default."""
+def _variant(set=None, **params):
+    """A ``make`` of ``make_recommended(**params)``, then ``set_params(**set)``:
+    the candidates of the default."""
 
     def make(joints, seed, memory_dir):
-        return skgesture.make_recommended(joints=joints, random_state=seed, **params)
+        model = skgesture.make_recommended(joints=joints, random_state=seed, **params)
+        return model.set_params(**(set or {}))
 
     return make
 
@@ -147,6 +149,8 @@ VARIANTS = {
     },
     "recommended (joints exact 8)": {"features": "joints", "lookahead": 8},
     "recommended (descriptor+joints)": {"features": "descriptor+joints"},
+    # "set": parameters of the model set after make_recommended
+    "recommended (namer 2 layers)": {"set": {"tagger__namer_hidden_sizes": (128, 128)}},
 }
 
 

@@ -70,3 +70,16 @@ def test_format_tables_prints_the_margins_under_the_table():
 def test_a_run_without_peers_prints_no_margin_table():
     text = bench_compare.format_tables([_row("PRECOG", "tcn", 0.7)], "compare")
     assert "Margin" not in text
+
+
+def test_a_variant_sets_the_parameters_of_the_recommended_model():
+    # a candidate of the default measured beside it: make_recommended, then its
+    # "set" parameters, unfitted, with the joints and seed of the run
+    model = bench_compare.REGISTRY["recommended (namer 2 layers)"].make(
+        "paper11", 3, None
+    )
+    tagger = model.named_steps["tagger"]
+    assert tagger.namer_hidden_sizes == (128, 128)
+    assert tagger.random_state == 3
+    default = bench_compare.REGISTRY["recommended"].make("paper11", 3, None)
+    assert default.named_steps["tagger"].namer_hidden_sizes == (128,)

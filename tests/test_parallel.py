@@ -121,7 +121,11 @@ def test_predict_files_on_dask_equals_serial_prediction(
         fitted[-1].predict_segments(fitted[:-1].transform([x]))[0] for x in streams.X
     ]
     for got, want in zip(segments, want_segments):
-        assert_array_equal(got, want)
+        # class, start and end exactly; the confidence (a mean of float32
+        # probabilities) to float32 rounding: a worker process's torch may
+        # sum in another order (a 1.5e-8 difference seen on a busy machine)
+        assert_array_equal(got[:, :3], want[:, :3])
+        assert_allclose(got[:, 3], want[:, 3], rtol=1e-6, atol=1e-7)
 
 
 def test_predict_files_writes_one_result_per_recording(tmp_path, streams, fitted):

@@ -1,6 +1,8 @@
 """SequenceTagger, VotingTagger, JointFeatures, SkeletonAugmenter and the decoding
 path, and make_recommended (issue 8's test list)."""
 
+import copy
+
 import joblib
 import numpy as np
 import pytest
@@ -136,6 +138,41 @@ def test_thread_setting_is_restored(toy):
     before = torch.get_num_threads()
     _tagger(max_epochs=1, n_threads=1).fit(X[:2], y[:2]).predict(X[:1])
     assert torch.get_num_threads() == before
+
+
+def test_decoding_runs_on_n_threads_blas_threads_and_restores_them(
+    fitted_gru, toy, monkeypatch
+):
+    # The novelty rule's products are small: BLAS threads beyond n_threads
+    # only wait on a busy machine (skgesture/utils/_threads.py).
+    from threadpoolctl import threadpool_info
+
+    from skgesture.utils import _novelty
+
+    X, _ = toy
+    blas = [i for i in threadpool_info() if i["user_api"] == "blas"]
+    if not blas:
+        pytest.skip("no BLAS library loaded")
+    before = [i["num_threads"] for i in blas]
+    seen = []
+    nearest = _novelty._nearest
+
+    def record(*args):
+        seen.append({i["num_threads"] for i in threadpool_info()
+                     if i["user_api"] == "blas"})  # fmt: skip
+        return nearest(*args)
+
+    monkeypatch.setattr(_novelty, "_nearest", record)
+    tagger = copy.deepcopy(fitted_gru).set_params(max_novelty=100.0, n_threads=1)
+    as_is = copy.deepcopy(fitted_gru).set_params(max_novelty=100.0, n_threads=None)
+    expected = as_is.predict(X)
+    seen.clear()
+    got = tagger.predict(X)
+    assert seen and all(threads == {1} for threads in seen)
+    assert [i["num_threads"] for i in threadpool_info()
+            if i["user_api"] == "blas"] == before  # fmt: skip
+    for a, b in zip(got, expected):
+        np.testing.assert_array_equal(a, b)
 
 
 # -- decoding without retraining ---------------------------------------------------

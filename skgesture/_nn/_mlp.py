@@ -2,7 +2,6 @@
 
 # SPDX-License-Identifier: BSD-3-Clause
 
-import functools
 from numbers import Integral, Real
 
 import numpy as np
@@ -15,6 +14,7 @@ from skgesture._nn._defaults import SCG_MAX_FAIL, TEST_FRACTION, VALIDATION_FRAC
 from skgesture._nn._fast import ACTIVATIONS, MLPProba
 from skgesture.utils._fitting import seed_from
 from skgesture.utils._params import NewParamsMixin
+from skgesture.utils._threads import blas_threads
 from skgesture.utils._validation import SequenceOf
 
 __all__ = ["TorchMLPClassifier", "fast_proba"]
@@ -246,10 +246,8 @@ class TorchMLPClassifier(NewParamsMixin, ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float32, reset=False)
         # getattr: a model pickled before n_threads existed keeps the BLAS setting.
-        n_threads = getattr(self, "n_threads", None)
-        if n_threads is None:
-            return MLPProba(self)(X)
-        with _blas_controller().limit(limits=n_threads, user_api="blas"):
+        # getattr: a model pickled before n_threads existed keeps the BLAS setting.
+        with blas_threads(getattr(self, "n_threads", None)):
             return MLPProba(self)(X)
 
     def predict(self, X):
@@ -286,11 +284,3 @@ def fast_proba(estimator):
     if not isinstance(estimator, TorchMLPClassifier):
         return estimator.predict_proba
     return MLPProba(estimator)
-
-
-@functools.cache
-def _blas_controller():
-    """One scan of the loaded BLAS libraries, reused by every prediction."""
-    from threadpoolctl import ThreadpoolController
-
-    return ThreadpoolController()

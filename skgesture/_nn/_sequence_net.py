@@ -423,11 +423,16 @@ def predict_whole(module, X, mean, scale, n_classes):
     out = [None] * len(X)
     causal = getattr(module, "lookahead", None) is not None
     lengths = [len(x) for x in X]
+    mean32, scale32 = np.asarray(mean, np.float32), np.asarray(scale, np.float32)
     for idx in _batches(lengths, causal):
         T = max(lengths[i] for i in idx)
         xb = np.zeros((len(idx), T, np.shape(X[idx[0]])[1]), dtype=np.float32)
         for row, i in enumerate(idx):
-            xb[row, : lengths[i]] = (X[i] - mean) / scale
+            xb[row, : lengths[i]] = X[i]
+            # standardised in float32, in place (no float64 copies): equal to
+            # the float64 route of the numpy scorers to float32 rounding
+            np.subtract(xb[row, : lengths[i]], mean32, out=xb[row, : lengths[i]])
+            np.divide(xb[row, : lengths[i]], scale32, out=xb[row, : lengths[i]])
         for i, p in zip(idx, frame_probabilities(module, xb)):
             out[i] = p[: lengths[i]].reshape(lengths[i], n_classes)
     return out

@@ -41,6 +41,7 @@ from skgesture._taggers._viterbi import DECISIONS, chain_lengths
 from skgesture.utils._fitting import fit_cached, seed_from
 from skgesture.utils._params import NewParamsMixin
 from skgesture.utils._segments import runs
+from skgesture.utils._threads import blas_threads
 from skgesture.utils._validation import (
     check_sequence_labels,
     check_sequences,
@@ -180,19 +181,25 @@ class _BaseTagger(NewParamsMixin, StreamableMixin, ClassifierMixin, BaseEstimato
     def _decode_all(self, proba, untracked, features):
         """:meth:`_decode` of every sequence; the run namer names the runs of
         all of them in one batch (:func:`~skgesture._taggers._namer.namer_batch`)."""
-        labels = [self._path(p, u) for p, u in zip(proba, untracked)]
-        namers = [None] * len(labels)
-        batch = self._namer_rule(batch=True)
-        if batch is not None:
-            spans = [
-                (i, s, e)
-                for i, lab in enumerate(labels)
-                for s, e, v in zip(*runs(lab))
-                if v != 0
-            ]
-            table = dict(zip(spans, batch([features[i][s:e] for i, s, e in spans])))
-            namers = [lambda s, e, i=i: table[(i, s, e)] for i in range(len(labels))]
-        return [self._judge(*args) for args in zip(labels, proba, features, namers)]
+        # numpy's products here are small (a run's rows projected for its
+        # novelty): BLAS threads beyond n_threads only wait (utils/_threads.py)
+        with blas_threads(getattr(self, "n_threads", None)):
+            labels = [self._path(p, u) for p, u in zip(proba, untracked)]
+            namers = [None] * len(labels)
+            batch = self._namer_rule(batch=True)
+            if batch is not None:
+                spans = [
+                    (i, s, e)
+                    for i, lab in enumerate(labels)
+                    for s, e, v in zip(*runs(lab))
+                    if v != 0
+                ]
+                rows = [features[i][s:e] for i, s, e in spans]
+                table = dict(zip(spans, batch(rows)))
+                namers = [
+                    lambda s, e, i=i: table[(i, s, e)] for i in range(len(labels))
+                ]
+            return [self._judge(*args) for args in zip(labels, proba, features, namers)]
 
     def _proba(self, X):
         """The network's probabilities and the untracked rows of every sequence."""

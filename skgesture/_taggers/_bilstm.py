@@ -351,8 +351,9 @@ class BiLSTMTagger(_BaseTagger):
         Torch device of the training (``"cuda"`` for :meth:`paper`). A fitted
         tagger loads and predicts on a machine without CUDA.
     n_threads : int or None, default=1
-        Torch intra-op CPU threads while fitting and predicting (the previous
-        setting is restored afterwards); ``None`` keeps torch's setting. One
+        Torch intra-op CPU threads while fitting and predicting, and numpy's
+        BLAS threads while decoding (the previous settings are restored
+        afterwards); ``None`` keeps their settings. One
         thread is fastest for the small default network and immune to
         oversubscription (see Notes); raise it for large networks on a CPU.
     random_state : int, RandomState instance or None, default=None

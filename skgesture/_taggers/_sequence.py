@@ -236,8 +236,8 @@ class SequenceTagger(_BaseTagger):
         machine without CUDA.
     n_threads : int or None, default=1
         Torch intra-op threads while predicting, and while fitting unless
-        ``fit_threads`` says otherwise (restored afterwards); None keeps
-        torch's setting.
+        ``fit_threads`` says otherwise, and numpy's BLAS threads while
+        decoding (both restored afterwards); None keeps their settings.
     fit_threads : int, "all" or None, default=None
         Torch intra-op threads while fitting: a number, every core of the
         machine (``"all"``; training is the one place where several threads

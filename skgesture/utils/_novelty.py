@@ -138,6 +138,7 @@ class PoseNovelty:
         # 0.2 s on one thread, for 5000 x 426 rows).
         values, vectors = np.linalg.eigh(sample.T @ sample)
         self.components_ = vectors[:, np.argsort(values)[::-1][:k]].T.copy()
+        self._projection = None  # made by _project from the fitted values
         Z = [self._project(x) for x in X]
         # frames of every class, with the sequence they come from
         labels = [np.where(t, np.asarray(v), -1) for v, t in zip(y, tracked)]
@@ -171,9 +172,14 @@ class PoseNovelty:
         return self
 
     def _project(self, x):
-        return (
-            (np.asarray(x, dtype=np.float64) - self.mean_) / self.scale_
-        ) @ self.components_.T
+        # ((x - mean) / scale) @ components.T as one product and one offset:
+        # no standardised copy of the (wide) features is made.
+        projection = getattr(self, "_projection", None)
+        if projection is None:  # (fitted objects pickled before it existed)
+            weights = self.components_.T / self.scale_[:, None]
+            projection = self._projection = (weights, self.mean_ @ weights)
+        weights, offset = projection
+        return np.asarray(x, dtype=np.float64) @ weights - offset
 
     def score(self, x, k=None):
         """Novelty of every frame, for every class or for column ``k``.
