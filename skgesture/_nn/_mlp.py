@@ -246,7 +246,6 @@ class TorchMLPClassifier(NewParamsMixin, ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float32, reset=False)
         # getattr: a model pickled before n_threads existed keeps the BLAS setting.
-        # getattr: a model pickled before n_threads existed keeps the BLAS setting.
         with blas_threads(getattr(self, "n_threads", None)):
             return MLPProba(self)(X)
 

@@ -428,11 +428,12 @@ def predict_whole(module, X, mean, scale, n_classes):
         T = max(lengths[i] for i in idx)
         xb = np.zeros((len(idx), T, np.shape(X[idx[0]])[1]), dtype=np.float32)
         for row, i in enumerate(idx):
-            xb[row, : lengths[i]] = X[i]
             # standardised in float32, in place (no float64 copies): equal to
             # the float64 route of the numpy scorers to float32 rounding
-            np.subtract(xb[row, : lengths[i]], mean32, out=xb[row, : lengths[i]])
-            np.divide(xb[row, : lengths[i]], scale32, out=xb[row, : lengths[i]])
+            rows = xb[row, : lengths[i]]
+            rows[...] = X[i]
+            rows -= mean32
+            rows /= scale32
         for i, p in zip(idx, frame_probabilities(module, xb)):
             out[i] = p[: lengths[i]].reshape(lengths[i], n_classes)
     return out
