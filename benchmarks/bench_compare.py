@@ -151,7 +151,7 @@ VARIANTS = {
     "recommended (descriptor+joints)": {"features": "descriptor+joints"},
     # "set": parameters of the model set after make_recommended
     "recommended (namer 2 layers)": {"set": {"tagger__namer_hidden_sizes": (128, 128)}},
-    "recommended (24 negatives)": {"set": {"background__n_sequences": 24}},
+    "recommended (12 negatives)": {"set": {"background__n_sequences": 12}},
 }
 
 

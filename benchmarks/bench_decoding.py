@@ -92,7 +92,7 @@ under the output folder too.
 
 ``--background NAME`` fits the variant ``NAME`` of ``BACKGROUNDS`` instead
 of the model's own background: ``synthetic`` is
-``make_recommended(background="synthetic")`` (12 synthetic negatives made
+``make_recommended(background="synthetic")`` (24 synthetic negatives made
 from every training fold), ``none`` no negatives, the others vary their count
 (``share10``: 10 % of the training sequences) and kinds (``nofragment``;
 ``motion``: random joint motion alone);

@@ -39,7 +39,7 @@ NAMER_WEIGHT = 0.75  # the run namer's share of a run's name (docs/design.md)
 NAMER_UNITS = (128,)  # the run namer's GRU: one layer of 128 units a direction
 NAMER_STRIDE = 2  # reading every second frame (docs/design.md, "The run namer")
 MAX_NAMER_REST = 0.5  # a run the namer calls rest at more than this is rest
-BACKGROUND_SEQUENCES = 12  # synthetic negatives made at every fit (background=)
+BACKGROUND_SEQUENCES = 24  # synthetic negatives made at every fit (background=)
 
 # docs/method.md §6.3
 WEIGHTS_B = (0.4895, 0.4576, 0.0529)
@@ -295,7 +295,7 @@ default="synthetic"
         Negatives made at every ``fit`` from its training recordings and
         learnt as rest (the pipeline's ``background``), by whom
         ``background_for`` says: ``"synthetic"`` is
-        :class:`~skgesture.datasets.SyntheticBackground` (12 sequences of
+        :class:`~skgesture.datasets.SyntheticBackground` (24 sequences of
         random joint motion, reversed gestures, fragments and concatenations,
         seeded by ``random_state``); None trains on the given data alone.
         Recordings of your own ordinary work, added to ``X`` with all-zero

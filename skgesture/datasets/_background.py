@@ -534,7 +534,7 @@ class SyntheticBackground(NewParamsMixin, BaseEstimator):
 
     Parameters
     ----------
-    n_sequences : int or float, default=12
+    n_sequences : int or float, default=24
         Sequences made at every ``fit``; a float in (0, 1) is that share of
         the recordings ``fit`` is given (see :func:`make_background`).
     n_frames : int or None, default=None
@@ -562,7 +562,7 @@ class SyntheticBackground(NewParamsMixin, BaseEstimator):
 
     def __init__(
         self,
-        n_sequences=12,
+        n_sequences=24,
         *,
         n_frames=None,
         kinds=None,
