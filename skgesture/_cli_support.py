@@ -27,12 +27,12 @@ F1_OVERLAPS = (0.1, 0.25, 0.5)
 FAST_MLP_HIDDEN = 32  # units of the one-layer networks of --fast (Methods A/B)
 FAST_TAGGER_HIDDEN = (16,)  # --fast tagger (Methods C and recommended)
 FAST_MAX_EPOCHS = 60
-# --fast recommended model: a one-stage TCN on fewer, smaller batches (about
-# 30 times less work per epoch than the default's 3 stages of 8 layers).
+# --fast recommended model: a one-stage TCN on fewer, smaller batches (a small
+# fraction of the work per epoch of the default's 2 stages of 8 layers).
 FAST_TCN = {"tcn_stages": 1, "tcn_layers": 6, "steps_per_epoch": 5, "batch_size": 8}
 # What --fast gives up, said before such a training (docs/cli.md has the measured cost).
 FAST_TRADEOFF = {
-    "recommended": "a one-stage, 6-layer temporal network instead of 3 stages of 8, "
+    "recommended": "a one-stage, 6-layer temporal network instead of 2 stages of 8, "
     "trained on 300 batches of 8 crops instead of 600 of 16",
     "A": "networks of one 32-unit layer instead of the paper's sizes, 60 epochs",
     "B": "networks of one 32-unit layer instead of the paper's sizes, 60 epochs",

@@ -27,6 +27,9 @@ __all__ = [
 
 # make_recommended's defaults (docs/choosing.md, docs/safety.md)
 LOOKAHEAD = 8  # frames of future the tagger reads
+TCN_CHANNELS = (40,)  # the TCN's width (docs/benchmarks.md, "Fewer, wider layers")
+TCN_LAYERS = 8  # dilated layers a stage (dilations 1 to 128)
+TCN_STAGES = 2  # stages, each refining the one before
 FEATURES = ("descriptor", "joints", "descriptor+joints")  # make_recommended's
 SMOOTHING_MARGIN = 4  # frames each side of a true boundary the smoothing loss spares
 MIN_DURATION = 0.5  # runs shorter than this fraction of their class's short gesture
@@ -243,7 +246,7 @@ def make_recommended(
 
     ``PoseDescriptor -> SequenceTagger(architecture="tcn", lookahead=8,
     namer="gru")``: the paper's pose descriptor of every frame, read by a
-    three-stage dilated temporal convolutional network (32 channels, 8 layers a
+    two-stage dilated temporal convolutional network (40 channels, 8 layers a
     stage, a smoothing loss that spares 4 frames each side of a true boundary,
     ``tagger__smoothing_margin``; Farha & Gall's MS-TCN) whose convolutions are
     causal and whose output for a frame is read 8 frames later, trained with
@@ -398,9 +401,9 @@ default="synthetic"
             )
     tagger = SequenceTagger(
         architecture="tcn",
-        hidden_sizes=(32,),
-        tcn_layers=8,
-        tcn_stages=3,
+        hidden_sizes=TCN_CHANNELS,
+        tcn_layers=TCN_LAYERS,
+        tcn_stages=TCN_STAGES,
         dropout=0.3,
         smoothing_weight=0.15,
         smoothing_margin=SMOOTHING_MARGIN,
