@@ -63,7 +63,7 @@ def test_rows_pair_every_variant_with_no_background(quick_run):
         assert set(r["events_per_min_by"]) == {"synthetic A", "synthetic B"}
         assert r["seeds"] == [0]
     assert base["worst change"] == 0.0
-    assert table[1]["what"] == "12 sequences, every kind"
+    assert table[1]["what"] == "24 sequences, every kind"
     assert table[2]["what"].startswith("10% of the training sequences")
 
 
@@ -73,7 +73,7 @@ def test_the_negatives_reach_the_fits(quick_run):
     assert backgrounds.count(None) == 2  # "none": one fit per quick dataset
     made = [bg for bg in backgrounds if bg is not None]
     assert len(made) == 4
-    assert {bg.n_sequences for bg in made} == {12, 0.1}
+    assert {bg.n_sequences for bg in made} == {24, 0.1}
 
 
 def test_figure_json_and_table(quick_run):

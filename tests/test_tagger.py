@@ -613,8 +613,11 @@ def test_make_recommended_default_streams_exactly_on_the_descriptor():
     assert offline.steps[0][1].statistics == "sequence"
     assert make_recommended(features="joints").steps[0][1].statistics == "running"
     # synthetic negatives that the run namer alone learns, and its rule on
-    assert model.background.n_sequences == 12 and model.background_for == "namer"
+    assert model.background.n_sequences == 24 and model.background_for == "namer"
     assert model.steps[-1][1].max_namer_rest == 0.5
+    # fewer, wider layers (docs/benchmarks.md, "Fewer, wider layers")
+    tagger = model.steps[-1][1]
+    assert (tagger.hidden_sizes, tagger.tcn_layers, tagger.tcn_stages) == ((40,), 8, 2)
 
 
 def test_make_recommended_gives_its_negatives_to_the_namer_alone():
