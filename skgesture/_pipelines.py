@@ -15,7 +15,7 @@ from skgesture._segmenter import ActivitySegmenter, default_frame_network
 from skgesture._taggers._bilstm import BiLSTMTagger
 from skgesture._taggers._sequence import SequenceTagger
 from skgesture._windows import STEPS_A, STEPS_B, DynamicPoseWindow
-from skgesture.datasets._background import SyntheticBackground
+from skgesture.datasets._background import BACKGROUND_SEQUENCES, SyntheticBackground
 
 __all__ = [
     "GesturePipeline",
@@ -42,7 +42,7 @@ NAMER_WEIGHT = 0.75  # the run namer's share of a run's name (docs/design.md)
 NAMER_UNITS = (128,)  # the run namer's GRU: one layer of 128 units a direction
 NAMER_STRIDE = 2  # reading every second frame (docs/design.md, "The run namer")
 MAX_NAMER_REST = 0.5  # a run the namer calls rest at more than this is rest
-BACKGROUND_SEQUENCES = 24  # synthetic negatives made at every fit (background=)
+# BACKGROUND_SEQUENCES: synthetic negatives made at every fit (from datasets)
 
 # docs/method.md §6.3
 WEIGHTS_B = (0.4895, 0.4576, 0.0529)

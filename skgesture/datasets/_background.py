@@ -520,6 +520,11 @@ recordings are left out.
 """
 
 
+# sequences a SyntheticBackground makes by default: make_recommended's
+# (docs/benchmarks.md, "Synthetic negatives by their cost")
+BACKGROUND_SEQUENCES = 24
+
+
 class SyntheticBackground(NewParamsMixin, BaseEstimator):
     """Background sequences made in ``fit``, from the training recordings.
 
@@ -562,7 +567,7 @@ class SyntheticBackground(NewParamsMixin, BaseEstimator):
 
     def __init__(
         self,
-        n_sequences=24,
+        n_sequences=BACKGROUND_SEQUENCES,
         *,
         n_frames=None,
         kinds=None,
