@@ -34,8 +34,8 @@ Protocol
 * **Background in fit** (``CONFIGS``): ``none``; ``synthetic``
   (``make_background`` of the fold's training recordings); or one real
   negative dataset. A real one is resampled to 30 fps, joined end to end and
-  cut into ``BACKGROUND_SEQUENCES`` (12) equal pieces, as many as the synthetic
-  background has sequences, so every configuration gives background the same
+  cut into ``BACKGROUND_PIECES`` (12) equal pieces, as many as the synthetic
+  background of this row has sequences, so every configuration gives background the same
   share of the tagger's training crops (they are drawn from uniformly chosen
   sequences). **A dataset used as background is never a test set of that
   row**: background MSR Action3D is tested on MSRC-12 and UTKinect, UTKinect on
@@ -131,7 +131,10 @@ THRESHOLDS = tuple(round(0.05 * i, 2) for i in range(20))  # 0 .. 0.95
 OPERATING_POINTS = (0.0, 0.6, 0.9)
 MIN_IOU = 0.5
 MIN_TRUE_LENGTH = 5
-BACKGROUND_SEQUENCES = 12
+# All-rest sequences given to fit (the user's "background recordings"), not
+# the model's own synthetic negatives for its run namer (24 by default,
+# skgesture.datasets.SyntheticBackground), which every row has.
+BACKGROUND_PIECES = 12
 TARGET_EVENTS_PER_MIN = 0.5
 TARGET_RECALL = 0.9
 TARGET_JACCARD_DROP = 0.01
@@ -301,10 +304,10 @@ def _background(config, X_tr, y_tr, negatives, fps, seed):
         return []
     if config == "synthetic":
         bg = make_background(
-            X_tr, y_tr, n_sequences=BACKGROUND_SEQUENCES, random_state=seed
+            X_tr, y_tr, n_sequences=BACKGROUND_PIECES, random_state=seed
         )
         return list(bg.X)
-    return background_pieces(negatives[config], fps, BACKGROUND_SEQUENCES)
+    return background_pieces(negatives[config], fps, BACKGROUND_PIECES)
 
 
 def fit_cell(config, seed, quick, X_tr, y_tr, X_te, negatives, fps):
@@ -459,8 +462,8 @@ def _background_label(config, negatives):
     if config == "none":
         return "none"
     if config == "synthetic":
-        return f"synthetic ({BACKGROUND_SEQUENCES} make_background sequences)"
-    return f"{config} ({BACKGROUND_SEQUENCES} pieces)"
+        return f"synthetic ({BACKGROUND_PIECES} make_background sequences)"
+    return f"{config} ({BACKGROUND_PIECES} pieces)"
 
 
 # ---------------------------------------------------------------- running
