@@ -27,7 +27,7 @@ __all__ = [
 
 # make_recommended's defaults (docs/choosing.md, docs/safety.md)
 LOOKAHEAD = 8  # frames of future the tagger reads
-TCN_CHANNELS = (40,)  # the TCN's width (docs/benchmarks.md, "Fewer, wider layers")
+TCN_CHANNELS = (48,)  # the TCN's width (docs/benchmarks.md, "Fewer, wider layers")
 TCN_LAYERS = 8  # dilated layers a stage (dilations 1 to 128)
 TCN_STAGES = 2  # stages, each refining the one before
 FEATURES = ("descriptor", "joints", "descriptor+joints")  # make_recommended's
@@ -246,7 +246,7 @@ def make_recommended(
 
     ``PoseDescriptor -> SequenceTagger(architecture="tcn", lookahead=8,
     namer="gru")``: the paper's pose descriptor of every frame, read by a
-    two-stage dilated temporal convolutional network (40 channels, 8 layers a
+    two-stage dilated temporal convolutional network (48 channels, 8 layers a
     stage, a smoothing loss that spares 4 frames each side of a true boundary,
     ``tagger__smoothing_margin``; Farha & Gall's MS-TCN) whose convolutions are
     causal and whose output for a frame is read 8 frames later, trained with

@@ -617,7 +617,7 @@ def test_make_recommended_default_streams_exactly_on_the_descriptor():
     assert model.steps[-1][1].max_namer_rest == 0.5
     # fewer, wider layers (docs/benchmarks.md, "Fewer, wider layers")
     tagger = model.steps[-1][1]
-    assert (tagger.hidden_sizes, tagger.tcn_layers, tagger.tcn_stages) == ((40,), 8, 2)
+    assert (tagger.hidden_sizes, tagger.tcn_layers, tagger.tcn_stages) == ((48,), 8, 2)
 
 
 def test_make_recommended_gives_its_negatives_to_the_namer_alone():
