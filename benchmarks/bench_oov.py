@@ -35,12 +35,13 @@ Protocol
   (``make_background`` of the fold's training recordings); or one real
   negative dataset. A real one is resampled to 30 fps, joined end to end and
   cut into ``BACKGROUND_PIECES`` (12) equal pieces, as many as the synthetic
-  background of this row has sequences, so every configuration gives background the same
-  share of the tagger's training crops (they are drawn from uniformly chosen
-  sequences). **A dataset used as background is never a test set of that
-  row**: background MSR Action3D is tested on MSRC-12 and UTKinect, UTKinect on
-  MSR Action3D and MSRC-12, MSRC-12 on MSR Action3D and UTKinect; ``none`` and
-  ``synthetic`` on all three. ``pooled`` = all test sets of the row together.
+  background of this row has sequences, so every configuration gives
+  background the same share of the tagger's training crops (they are drawn
+  from uniformly chosen sequences). **A dataset used as background is never
+  a test set of that row**: background MSR Action3D is tested on MSRC-12 and
+  UTKinect, UTKinect on MSR Action3D and MSRC-12, MSRC-12 on MSR Action3D and
+  UTKinect; ``none`` and ``synthetic`` on all three. ``pooled`` = all test
+  sets of the row together.
 * **Events**: ``model.predict_segments(X, fps=fps)``, rows ``(class, start,
   end, confidence)``: the runs of ``predict``, the confidence the mean
   probability of the class over the run. At a confidence threshold ``t`` the
